@@ -137,9 +137,11 @@ namespace {
 image_t encode(const cv::Mat& mat, int8_t f, const std::string& ext, const std::vector<int>& params, int64_t utime,
                const std::string& frame, float depth_scale) {
   if (mat.empty()) throw ImageError("encode " + ext + ": empty image");
-  cv::Mat bgr = mat;
+  // A fresh Mat for the conversion: cvtColor into a header copy would write into the caller's pixels.
+  cv::Mat bgr;
   if (mat.type() == CV_8UC3) cv::cvtColor(mat, bgr, cv::COLOR_RGB2BGR);
-  else if (mat.type() != CV_8UC1 && !(mat.type() == CV_16UC1 && ext == ".png"))
+  else bgr = mat;
+  if (mat.type() != CV_8UC3 && mat.type() != CV_8UC1 && !(mat.type() == CV_16UC1 && ext == ".png"))
     throw ImageError("encode " + ext + ": unsupported cv::Mat type " + std::to_string(mat.type()));
   std::vector<uint8_t> buf;
   if (!cv::imencode(ext, bgr, buf, params)) throw ImageError("encode " + ext + ": OpenCV failed");
@@ -167,9 +169,10 @@ image_t encode_jpeg(const cv::Mat& mat, int64_t utime, const std::string& frame,
 }
 
 void write_png(const std::string& path, const cv::Mat& mat) {
-  cv::Mat out = mat;
+  cv::Mat out;
   if (mat.type() == CV_8UC3) cv::cvtColor(mat, out, cv::COLOR_RGB2BGR);
-  else if (mat.type() != CV_8UC1 && mat.type() != CV_16UC1)
+  else out = mat;
+  if (mat.type() != CV_8UC3 && mat.type() != CV_8UC1 && mat.type() != CV_16UC1)
     throw ImageError("write_png " + path + ": unsupported cv::Mat type " + std::to_string(mat.type()));
   if (!cv::imwrite(path, out)) throw ImageError("write_png: cannot write '" + path + "'");
 }

@@ -110,6 +110,7 @@ int run_service_main(int argc, char** argv, const ServiceDescription& d) {
     }
   }
   host->publish_stopping(clock.now_utime());
+  host->component().detach();  // before `lcm` goes out of scope
   std::cerr << d.name << ": stopped cleanly\n";
   return 0;
 }
