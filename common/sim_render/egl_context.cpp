@@ -49,7 +49,7 @@ EglContext::EglContext() {
   EGLDisplay display = shared_display();
   const EGLint config_attribs[] = {EGL_RED_SIZE,   8, EGL_GREEN_SIZE,      8, EGL_BLUE_SIZE,       8,
                                    EGL_ALPHA_SIZE, 8, EGL_DEPTH_SIZE,      24, EGL_STENCIL_SIZE,   8,
-                                   EGL_RENDERABLE_TYPE, EGL_OPENGL_BIT, EGL_NONE};
+                                   EGL_RENDERABLE_TYPE, EGL_OPENGL_BIT, EGL_SURFACE_TYPE, EGL_PBUFFER_BIT, EGL_NONE};
   EGLConfig config = nullptr;
   EGLint num_configs = 0;
   if (eglChooseConfig(display, config_attribs, &config, 1, &num_configs) != EGL_TRUE || num_configs < 1) {
