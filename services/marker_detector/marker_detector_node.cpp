@@ -1,0 +1,187 @@
+#include "services/marker_detector/marker_detector_node.h"
+
+#include <chrono>
+#include <cmath>
+#include <stdexcept>
+
+#include <opencv2/imgproc.hpp>
+
+#include "common/image_conversion.h"
+#include "common/pose_conversion.h"
+
+namespace bookgrasp {
+
+MarkerDetectorSettings MarkerDetectorSettings::from_config(const Config& root) {
+  MarkerDetectorSettings s;
+  s.input_channel = root.get<std::string>("channels.input");
+  s.output_channel = root.get<std::string>("channels.output");
+  s.detector = TagDetectorParams::from_config(root.child("apriltag"));
+  s.default_tag_size_m = root.get_double("tags.default_size_m", 0.005, 2.0);
+  s.cart_ids = root.get<std::vector<int>>("tags.cart.ids");
+  s.cart_tag_size_m = root.get_double("tags.cart.size_m", 0.005, 2.0);
+  s.holder_ids = root.get<std::vector<int>>("tags.holder.ids");
+  s.holder_tag_size_m = root.get_double("tags.holder.size_m", 0.005, 2.0);
+  s.report_unassigned = root.get<bool>("tags.report_unassigned");
+  s.measure_processing_time = root.get<bool>("diagnostics.measure_processing_time");
+  for (int id : s.cart_ids) {
+    for (int h : s.holder_ids) {
+      if (id == h) {
+        throw ConfigError(root.source() + ": " + root.path_of("tags.holder.ids") + ": id " + std::to_string(id) +
+                          " is also in tags.cart.ids; give each marker one role");
+      }
+    }
+    if (id < 0) throw ConfigError(root.source() + ": " + root.path_of("tags.cart.ids") + ": ids must be >= 0");
+  }
+  for (int id : s.holder_ids) {
+    if (id < 0) throw ConfigError(root.source() + ": " + root.path_of("tags.holder.ids") + ": ids must be >= 0");
+  }
+  return s;
+}
+
+bool intrinsics_from_calibration(const camera_calibration_t& c, int image_width, int image_height,
+                                 CameraIntrinsics* k, std::string* reason) {
+  if (!std::isfinite(c.fx) || !std::isfinite(c.fy) || !std::isfinite(c.cx) || !std::isfinite(c.cy)) {
+    *reason = "calibration has a non-finite fx, fy, cx or cy";
+    return false;
+  }
+  if (c.fx <= 0.0 || c.fy <= 0.0) {
+    *reason = "calibration focal lengths must be > 0 (fx=" + std::to_string(c.fx) + ", fy=" + std::to_string(c.fy) + ")";
+    return false;
+  }
+  if (c.width != image_width || c.height != image_height) {
+    *reason = "image is " + std::to_string(image_width) + "x" + std::to_string(image_height) +
+              " but its calibration is for " + std::to_string(c.width) + "x" + std::to_string(c.height);
+    return false;
+  }
+  if (c.num_distortion != static_cast<int32_t>(c.distortion.size())) {
+    *reason = "calibration num_distortion (" + std::to_string(c.num_distortion) + ") does not match the " +
+              std::to_string(c.distortion.size()) + " coefficients sent";
+    return false;
+  }
+  for (double d : c.distortion) {
+    if (!std::isfinite(d)) {
+      *reason = "calibration has a non-finite distortion coefficient";
+      return false;
+    }
+  }
+  k->fx = c.fx;
+  k->fy = c.fy;
+  k->cx = c.cx;
+  k->cy = c.cy;
+  k->distortion.clear();
+  if (c.distortion_model == "none" || c.distortion_model.empty()) {
+    for (double d : c.distortion) {
+      if (d != 0.0) {
+        *reason = "calibration distortion_model is 'none' but it carries non-zero coefficients";
+        return false;
+      }
+    }
+  } else if (c.distortion_model == "plumb_bob") {
+    if (c.num_distortion != 5) {
+      *reason = "plumb_bob distortion needs 5 coefficients (k1 k2 p1 p2 k3), got " + std::to_string(c.num_distortion);
+      return false;
+    }
+    k->distortion = c.distortion;
+  } else {
+    *reason = "unknown distortion_model '" + c.distortion_model + "' (use 'none' or 'plumb_bob')";
+    return false;
+  }
+  return true;
+}
+
+MarkerDetectorNode::MarkerDetectorNode(const MarkerDetectorSettings& settings)
+    : Component("marker_detector", "apriltag3"), settings_(settings), detector_(settings.detector) {
+  for (int id : settings_.cart_ids) role_of_id_[id] = "cart";
+  for (int id : settings_.holder_ids) role_of_id_[id] = "holder";
+  subscribe(settings_.input_channel, &MarkerDetectorNode::on_stereo);
+}
+
+bool MarkerDetectorNode::process(const stereo_frame_t& frame, marker_detections_t* out, std::string* reason) {
+  const auto start = std::chrono::steady_clock::now();
+  cv::Mat image;
+  try {
+    image = image_to_mat(frame.left);
+  } catch (const std::exception& e) {
+    *reason = std::string("left image cannot be decoded: ") + e.what();
+    return false;
+  }
+  cv::Mat gray;
+  if (image.type() == CV_8UC1) {
+    gray = image;
+  } else if (image.type() == CV_8UC3) {
+    cv::cvtColor(image, gray, cv::COLOR_RGB2GRAY);
+  } else {
+    *reason = "left image pixel format " + pixel_format_name(frame.left.pixel_format) +
+              " is not an intensity image (send GRAY8, RGB8, PNG or JPEG)";
+    return false;
+  }
+  CameraIntrinsics k;
+  if (!intrinsics_from_calibration(frame.left_calibration, gray.cols, gray.rows, &k, reason)) {
+    *reason = "left " + *reason;
+    return false;
+  }
+  if (!is_valid_pose(frame.left_calibration.camera_in_base)) {
+    *reason = "left calibration camera_in_base is not a valid pose (NaN or non-unit quaternion)";
+    return false;
+  }
+  const Eigen::Isometry3d camera_in_base = pose_to_isometry(frame.left_calibration.camera_in_base);
+  const std::string camera_frame =
+      frame.left_calibration.frame.empty() ? frame.left.frame : frame.left_calibration.frame;
+
+  const std::vector<TagDetection> detections = detector_.detect(gray);
+  out->utime = frame.left.utime;
+  out->implementation = implementation();
+  out->camera_frame = camera_frame;
+  out->markers.clear();
+  for (const TagDetection& d : detections) {
+    const auto role_it = role_of_id_.find(d.id);
+    const std::string role = role_it == role_of_id_.end() ? "" : role_it->second;
+    if (role.empty() && !settings_.report_unassigned) continue;
+    const double size = role == "cart"     ? settings_.cart_tag_size_m
+                        : role == "holder" ? settings_.holder_tag_size_m
+                                           : settings_.default_tag_size_m;
+    TagPose pose;
+    try {
+      pose = estimate_tag_pose(d.corners, size, k);
+    } catch (const std::exception& e) {
+      report_error("tag " + std::to_string(d.id) + ": " + e.what());
+      continue;
+    }
+    marker_t m;
+    m.utime = out->utime;
+    m.family = d.family;
+    m.id = d.id;
+    m.role = role;
+    for (int i = 0; i < 4; ++i) {
+      m.corners_px[i][0] = d.corners[static_cast<size_t>(i)].x;
+      m.corners_px[i][1] = d.corners[static_cast<size_t>(i)].y;
+    }
+    m.center_px[0] = d.center.x;
+    m.center_px[1] = d.center.y;
+    const std::string child = role.empty() ? d.family + "_" + std::to_string(d.id) : role;
+    m.pose_in_camera = isometry_to_pose(pose.tag_in_camera, camera_frame, child, out->utime);
+    m.pose_in_base = isometry_to_pose(camera_in_base * pose.tag_in_camera, "base", child, out->utime);
+    m.decision_margin = d.decision_margin;
+    m.hamming = d.hamming;
+    m.reprojection_error_px = pose.reprojection_error_px;
+    out->markers.push_back(m);
+  }
+  out->num_markers = static_cast<int32_t>(out->markers.size());
+  out->processing_ms =
+      settings_.measure_processing_time
+          ? std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count()
+          : 0.0;
+  return true;
+}
+
+void MarkerDetectorNode::on_stereo(const stereo_frame_t& frame) {
+  marker_detections_t out;
+  std::string reason;
+  if (!process(frame, &out, &reason)) {
+    reject(settings_.input_channel, reason);
+    return;
+  }
+  publish(settings_.output_channel, out);
+}
+
+}  // namespace bookgrasp

@@ -1,0 +1,64 @@
+#pragma once
+/// @file
+/// The marker_detector component: STEREO_IMAGES (left image + left
+/// calibration) -> MARKERS (every tag with its pose in the camera and in
+/// `base`, and the role of the cart and holder markers).
+
+#include <map>
+#include <string>
+#include <vector>
+
+#include "bookgrasp/marker_detections_t.hpp"
+#include "bookgrasp/stereo_frame_t.hpp"
+#include "common/component.h"
+#include "common/config.h"
+#include "services/marker_detector/tag_detector.h"
+#include "services/marker_detector/tag_pose.h"
+
+namespace bookgrasp {
+
+/// Everything the marker detector reads from its configuration.
+struct MarkerDetectorSettings {
+  std::string input_channel;      ///< channels.input (stereo_frame_t)
+  std::string output_channel;     ///< channels.output (marker_detections_t)
+  TagDetectorParams detector;     ///< apriltag.*
+  double default_tag_size_m = 0;  ///< tags.default_size_m: size of tags without a role
+  std::vector<int> cart_ids;      ///< tags.cart.ids
+  double cart_tag_size_m = 0;     ///< tags.cart.size_m
+  std::vector<int> holder_ids;    ///< tags.holder.ids
+  double holder_tag_size_m = 0;   ///< tags.holder.size_m
+  bool report_unassigned = true;  ///< tags.report_unassigned: publish tags whose id has no role
+  bool measure_processing_time = true;  ///< diagnostics.measure_processing_time (wall time in processing_ms)
+
+  /// Reads the whole configuration root (channels, apriltag, tags,
+  /// diagnostics). Throws ConfigError naming a bad key (also for an id that
+  /// is both a cart and a holder id).
+  static MarkerDetectorSettings from_config(const Config& root);
+};
+
+/// Checks a calibration and returns its intrinsics; on a problem returns
+/// false and says what is wrong in `reason` (NaN, non-positive focal length,
+/// unknown distortion model, wrong coefficient count, size mismatch).
+bool intrinsics_from_calibration(const camera_calibration_t& calib, int image_width, int image_height,
+                                 CameraIntrinsics* intrinsics, std::string* reason);
+
+/// The AprilTag marker detector as a component.
+class MarkerDetectorNode : public Component {
+ public:
+  /// Subscribes settings.input_channel. Throws std::invalid_argument for bad detector parameters.
+  explicit MarkerDetectorNode(const MarkerDetectorSettings& settings);
+
+  /// Detects markers in one stereo frame (left image); the core of the
+  /// handler, usable without a bus. Returns false and a reason for a frame
+  /// that cannot be processed.
+  bool process(const stereo_frame_t& frame, marker_detections_t* out, std::string* reason);
+
+ private:
+  void on_stereo(const stereo_frame_t& frame);
+
+  MarkerDetectorSettings settings_;
+  TagDetector detector_;
+  std::map<int, std::string> role_of_id_;
+};
+
+}  // namespace bookgrasp

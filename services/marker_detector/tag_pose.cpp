@@ -1,0 +1,92 @@
+#include "services/marker_detector/tag_pose.h"
+
+#include <cmath>
+#include <stdexcept>
+
+#include <opencv2/calib3d.hpp>
+#include <opencv2/core/eigen.hpp>
+
+namespace bookgrasp {
+namespace {
+
+std::vector<cv::Point3d> tag_object_points(double s) {
+  const double h = s / 2.0;
+  return {{-h, h, 0.0}, {h, h, 0.0}, {h, -h, 0.0}, {-h, -h, 0.0}};
+}
+
+cv::Mat camera_matrix(const CameraIntrinsics& k) {
+  return (cv::Mat_<double>(3, 3) << k.fx, 0.0, k.cx, 0.0, k.fy, k.cy, 0.0, 0.0, 1.0);
+}
+
+cv::Mat distortion_vector(const CameraIntrinsics& k) {
+  if (k.distortion.empty()) return cv::Mat();
+  return cv::Mat(k.distortion, true).reshape(1, 1);
+}
+
+void check_intrinsics(const CameraIntrinsics& k) {
+  const bool finite = std::isfinite(k.fx) && std::isfinite(k.fy) && std::isfinite(k.cx) && std::isfinite(k.cy);
+  if (!finite || k.fx <= 0.0 || k.fy <= 0.0) {
+    throw std::invalid_argument("camera intrinsics must be finite with fx, fy > 0");
+  }
+  for (double d : k.distortion) {
+    if (!std::isfinite(d)) throw std::invalid_argument("distortion coefficients must be finite");
+  }
+}
+
+}  // namespace
+
+TagPose estimate_tag_pose(const std::array<cv::Point2d, 4>& corners, double tag_size_m,
+                          const CameraIntrinsics& intrinsics) {
+  if (!(tag_size_m > 0.0) || !std::isfinite(tag_size_m)) {
+    throw std::invalid_argument("tag size must be a positive number of metres");
+  }
+  check_intrinsics(intrinsics);
+  for (const auto& c : corners) {
+    if (!std::isfinite(c.x) || !std::isfinite(c.y)) throw std::invalid_argument("tag corners must be finite");
+  }
+  const std::vector<cv::Point3d> object = tag_object_points(tag_size_m);
+  const std::vector<cv::Point2d> image(corners.begin(), corners.end());
+  const cv::Mat k = camera_matrix(intrinsics);
+  const cv::Mat dist = distortion_vector(intrinsics);
+  cv::Mat rvec, tvec;
+  if (!cv::solvePnP(object, image, k, dist, rvec, tvec, false, cv::SOLVEPNP_IPPE_SQUARE)) {
+    throw std::runtime_error("no pose for the tag corners (degenerate quadrilateral)");
+  }
+  cv::solvePnPRefineLM(object, image, k, dist, rvec, tvec);
+
+  cv::Mat r;
+  cv::Rodrigues(rvec, r);
+  Eigen::Matrix3d rot;
+  cv::cv2eigen(r, rot);
+  TagPose pose;
+  pose.tag_in_camera.linear() = rot;
+  pose.tag_in_camera.translation() = Eigen::Vector3d(tvec.at<double>(0), tvec.at<double>(1), tvec.at<double>(2));
+
+  std::vector<cv::Point2d> projected;
+  cv::projectPoints(object, rvec, tvec, k, dist, projected);
+  double sum = 0.0;
+  for (size_t i = 0; i < 4; ++i) {
+    const cv::Point2d d = projected[i] - image[i];
+    sum += d.dot(d);
+  }
+  pose.reprojection_error_px = std::sqrt(sum / 4.0);
+  return pose;
+}
+
+std::array<cv::Point2d, 4> project_tag_corners(const Eigen::Isometry3d& tag_in_camera, double tag_size_m,
+                                               const CameraIntrinsics& intrinsics) {
+  check_intrinsics(intrinsics);
+  const std::vector<cv::Point3d> object = tag_object_points(tag_size_m);
+  cv::Mat r;
+  const Eigen::Matrix3d rot = tag_in_camera.rotation();
+  cv::eigen2cv(rot, r);
+  cv::Mat rvec;
+  cv::Rodrigues(r, rvec);
+  const Eigen::Vector3d t = tag_in_camera.translation();
+  const cv::Mat tvec = (cv::Mat_<double>(3, 1) << t.x(), t.y(), t.z());
+  std::vector<cv::Point2d> projected;
+  cv::projectPoints(object, rvec, tvec, camera_matrix(intrinsics), distortion_vector(intrinsics), projected);
+  return {projected[0], projected[1], projected[2], projected[3]};
+}
+
+}  // namespace bookgrasp
