@@ -19,7 +19,7 @@ InverseKinematics::InverseKinematics(ArmKinematics kinematics, IkParams params)
     throw std::invalid_argument("IK preferred posture is outside the joint limits");
   if (params_.position_tolerance_m <= 0 || params_.orientation_tolerance_rad <= 0 || params_.max_iterations <= 0 ||
       params_.damping <= 0 || params_.max_step_rad <= 0 || params_.max_restarts < 0 ||
-      params_.orientation_weight_m <= 0 || params_.nullspace_gain < 0)
+      params_.orientation_weight_m <= 0 || params_.nullspace_gain < 0 || params_.posture_iterations < 0)
     throw std::invalid_argument("IK parameters must be positive (tolerances, iterations, damping, step, weight)");
 }
 
@@ -37,34 +37,65 @@ IkResult InverseKinematics::solve_once(const Eigen::Isometry3d& target, const Ei
   const double lambda2 = params_.damping * params_.damping;
   Eigen::Matrix<double, 6, 1> err;
   double pos_err = 0, rot_err = 0;
-  for (int it = 0; it <= max_iterations; ++it) {
+  Eigen::VectorXd best_q = q;  // last iterate within the tolerances
+  int posture_left = params_.posture_iterations;
+  for (int it = 0;; ++it) {
     kin_.tip_pose_and_jacobian(q, tip, jac);
     err.head<3>() = target.translation() - tip.translation();
     err.tail<3>() = orientation_error(tip.linear(), target.linear());
-    pos_err = err.head<3>().norm();
-    rot_err = err.tail<3>().norm();
-    if (pos_err < params_.position_tolerance_m && rot_err < params_.orientation_tolerance_rad) {
+    const double p_err = err.head<3>().norm(), o_err = err.tail<3>().norm();
+    const bool converged = p_err < params_.position_tolerance_m && o_err < params_.orientation_tolerance_rad;
+    if (converged) {
       r.success = true;
-      break;
+      best_q = q;
+      pos_err = p_err;
+      rot_err = o_err;
+      if (posture_left-- <= 0 || params_.nullspace_gain <= 0) break;
+    } else if (r.success) {
+      break;  // a posture step left the tolerance: keep the previous iterate
+    } else {
+      best_q = q;
+      pos_err = p_err;
+      rot_err = o_err;
     }
-    if (it == max_iterations) break;
+    if (it >= max_iterations + (r.success ? params_.posture_iterations : 0)) break;
     r.iterations = it + 1;
     // Weighted task: orientation rows scaled to metres so damping acts evenly.
     jac.bottomRows<3>() *= w;
     err.tail<3>() *= w;
-    const Eigen::Matrix<double, 6, 6> jjt = jac * jac.transpose() + lambda2 * Eigen::Matrix<double, 6, 6>::Identity();
-    const Eigen::LDLT<Eigen::Matrix<double, 6, 6>> ldlt(jjt);
-    Eigen::VectorXd dq = jac.transpose() * ldlt.solve(err);
+    // Joints resting on a limit and pushed further out are removed from the task for this step.
+    Eigen::VectorXd dq;
+    for (int pass = 0; pass < 2; ++pass) {
+      const Eigen::Matrix<double, 6, 6> jjt =
+          jac * jac.transpose() + lambda2 * Eigen::Matrix<double, 6, 6>::Identity();
+      dq = jac.transpose() * jjt.ldlt().solve(err);
+      bool blocked = false;
+      for (int k = 0; k < n; ++k) {
+        if ((q[k] <= lo[k] && dq[k] < 0) || (q[k] >= hi[k] && dq[k] > 0)) {
+          if (jac.col(k).squaredNorm() > 0) blocked = true;
+          jac.col(k).setZero();
+        }
+      }
+      if (!blocked) break;
+    }
     // Null space: pull towards the preferred posture without disturbing the task (to first order).
     if (params_.nullspace_gain > 0) {
       const Eigen::VectorXd posture = params_.nullspace_gain * (params_.preferred_posture - q);
-      const Eigen::VectorXd projected = posture - jac.transpose() * ldlt.solve(jac * posture);
+      // Projector from a nearly undamped pseudo-inverse: the damped one leaks into the task and
+      // would stall convergence a few millimetres short of the target.
+      const Eigen::Matrix<double, 6, 6> jjt_exact =
+          jac * jac.transpose() + 1e-8 * Eigen::Matrix<double, 6, 6>::Identity();
+      const Eigen::VectorXd projected = posture - jac.transpose() * jjt_exact.ldlt().solve(jac * posture);
+      if (converged && projected.cwiseAbs().maxCoeff() < 1e-4) break;  // posture settled
       dq += projected;
+    } else if (converged) {
+      break;
     }
     const double step = dq.cwiseAbs().maxCoeff();
     if (step > params_.max_step_rad) dq *= params_.max_step_rad / step;
     q = (q + dq).cwiseMax(lo).cwiseMin(hi);
   }
+  q = best_q;
   r.q = q;
   r.position_error_m = pos_err;
   r.orientation_error_rad = rot_err;

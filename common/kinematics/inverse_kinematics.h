@@ -25,6 +25,7 @@ struct IkParams {
   double max_step_rad = 0.3;           ///< largest joint change per iteration
   double nullspace_gain = 0.1;         ///< posture pull (fraction of the posture error per iteration)
   double orientation_weight_m = 0.2;   ///< metres per radian when mixing position and orientation errors
+  int posture_iterations = 30;         ///< extra iterations after convergence that only improve the posture
   Eigen::VectorXd preferred_posture;   ///< posture the null-space term pulls towards (num_joints values)
   uint64_t seed = 1;                   ///< seed of the restart generator (same seed -> same answer)
 };
