@@ -1,0 +1,188 @@
+#include "services/bws_detector/book_front_selection.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <sstream>
+#include <stdexcept>
+
+#include "common/config.h"
+
+namespace bookgrasp::bws {
+
+SelectionParams SelectionParams::from_config(const Config& c) {
+  SelectionParams p;
+  p.parallel_tolerance_deg = c.get_double("parallel_tolerance_deg", 0.0, 90.0);
+  p.perpendicular_tolerance_deg = c.get_double("perpendicular_tolerance_deg", 0.0, 90.0);
+  p.min_width_m = c.get_double("min_width_m", 0.0, 10.0);
+  p.max_width_m = c.get_double("max_width_m", p.min_width_m, 10.0);
+  p.min_height_m = c.get_double("min_height_m", 0.0, 10.0);
+  p.max_height_m = c.get_double("max_height_m", p.min_height_m, 10.0);
+  p.min_inside_fraction = c.get_double("min_inside_fraction", 0.0, 1.0);
+  p.min_pixels = c.get_int("min_pixels", 1, 100000000);
+  p.extent_quantile = c.get_double("extent_quantile", 0.0, 0.49);
+  return p;
+}
+
+cv::Point upper_right_corner(const cv::Mat& labels, int label, bool* fallback) {
+  if (labels.type() != CV_32S) throw std::invalid_argument("upper_right_corner: labels must be CV_32S");
+  int y_min = -1, x_max = -1;
+  for (int y = 0; y < labels.rows; ++y) {
+    const int* l = labels.ptr<int>(y);
+    for (int x = 0; x < labels.cols; ++x)
+      if (l[x] == label) {
+        if (y_min < 0) y_min = y;
+        x_max = std::max(x_max, x);
+      }
+  }
+  if (y_min < 0) throw std::invalid_argument("upper_right_corner: label " + std::to_string(label) + " not present");
+  if (labels.at<int>(y_min, x_max) == label) {
+    if (fallback) *fallback = false;
+    return {x_max, y_min};
+  }
+  if (fallback) *fallback = true;
+  long best = std::numeric_limits<long>::max();
+  cv::Point best_p(-1, -1);
+  for (int y = y_min; y < labels.rows; ++y) {  // no region pixel above y_min
+    const long dy = y - y_min;
+    if (dy * dy > best) break;
+    const int* l = labels.ptr<int>(y);
+    for (int x = x_max; x >= 0; --x) {  // larger column first: ties keep the larger column
+      if (l[x] != label) continue;
+      const long dx = x_max - x;
+      const long d = dx * dx + dy * dy;
+      if (d < best) {
+        best = d;
+        best_p = {x, y};
+      }
+    }
+  }
+  return best_p;
+}
+
+namespace {
+double quantile(std::vector<double>& v, double q) {
+  if (v.empty()) return std::numeric_limits<double>::quiet_NaN();
+  const size_t k = std::min(v.size() - 1, size_t(std::floor(q * double(v.size() - 1) + 0.5)));
+  std::nth_element(v.begin(), v.begin() + long(k), v.end());
+  return v[k];
+}
+std::string fmt(double v, int prec = 3) {
+  std::ostringstream s;
+  s.setf(std::ios::fixed);
+  s.precision(prec);
+  s << v;
+  return s.str();
+}
+}  // namespace
+
+BookFrontResult select_book_front(const SegmentationResult& seg, const cv::Mat& points_camera,
+                                  const StereoGeometry& g, const Eigen::Isometry3d& camera_in_base,
+                                  const ShelfVolume& shelf, const SelectionParams& p) {
+  if (points_camera.type() != CV_32FC3 || points_camera.size() != seg.labels.size())
+    throw std::invalid_argument("select_book_front: points must be CV_32FC3 of the label image's size");
+  const size_t K = seg.regions.size();
+  // Points of every region in the shelf-box frame.
+  const Eigen::Isometry3d cam_in_box = shelf.box_in_base.inverse() * camera_in_base;
+  std::vector<std::vector<Eigen::Vector3f>> box_pts(K + 1);
+  for (int y = 0; y < seg.labels.rows; ++y) {
+    const int* l = seg.labels.ptr<int>(y);
+    const cv::Vec3f* q = points_camera.ptr<cv::Vec3f>(y);
+    for (int x = 0; x < seg.labels.cols; ++x) {
+      const int lab = l[x];
+      if (lab <= 0 || size_t(lab) > K) continue;
+      if (!(std::isfinite(q[x][0]) && std::isfinite(q[x][1]) && std::isfinite(q[x][2]))) continue;
+      box_pts[size_t(lab)].push_back((cam_in_box * Eigen::Vector3d(q[x][0], q[x][1], q[x][2])).cast<float>());
+    }
+  }
+  const Eigen::Matrix3d R = camera_in_base.linear();
+  const Eigen::Vector3d rear_n = shelf.box_in_base.linear().col(0);
+  const Eigen::Vector3d shelf_n = shelf.box_in_base.linear().col(2);
+  const double cos_par = std::cos(p.parallel_tolerance_deg * M_PI / 180.0);
+  const double sin_perp = std::sin(p.perpendicular_tolerance_deg * M_PI / 180.0);
+
+  BookFrontResult out;
+  int best = 0;
+  double best_y = std::numeric_limits<double>::infinity();
+  for (const PlaneRegion& r : seg.regions) {
+    RegionVerdict v;
+    v.label = r.label;
+    v.normal_base = R * r.normal;
+    v.offset_base = r.offset + v.normal_base.dot(camera_in_base.translation());
+    v.centroid_base = camera_in_base * r.centroid;
+    auto& pts = box_pts[size_t(r.label)];
+    if (!pts.empty()) {
+      std::vector<double> c[3], b[3];
+      int inside = 0;
+      for (const auto& q : pts) {
+        const Eigen::Vector3d qb = shelf.box_in_base * q.cast<double>();
+        for (int i = 0; i < 3; ++i) {
+          c[i].push_back(qb(i));
+          b[i].push_back(q(i));
+        }
+        if (std::fabs(q.x()) <= shelf.half_extent.x() && std::fabs(q.y()) <= shelf.half_extent.y() &&
+            std::fabs(q.z()) <= shelf.half_extent.z())
+          ++inside;
+      }
+      v.inside_fraction = double(inside) / double(pts.size());
+      for (int i = 0; i < 3; ++i) {
+        v.extent_min_base(i) = quantile(c[i], p.extent_quantile);
+        v.extent_max_base(i) = quantile(c[i], 1.0 - p.extent_quantile);
+      }
+      v.width_m = quantile(b[1], 1.0 - p.extent_quantile) - quantile(b[1], p.extent_quantile);
+      v.height_m = quantile(b[2], 1.0 - p.extent_quantile) - quantile(b[2], p.extent_quantile);
+    }
+    const double par = std::fabs(v.normal_base.dot(rear_n));
+    const double perp = std::fabs(v.normal_base.dot(shelf_n));
+    if (r.pixel_count < p.min_pixels) {
+      v.reason = "too small: " + std::to_string(r.pixel_count) + " px < " + std::to_string(p.min_pixels);
+    } else if (par < cos_par) {
+      v.reason = "not parallel to the rear board: " + fmt(std::acos(std::min(1.0, par)) * 180.0 / M_PI, 1) +
+                 " deg > " + fmt(p.parallel_tolerance_deg, 1);
+    } else if (perp > sin_perp) {
+      v.reason = "not perpendicular to the shelf: off by " + fmt(std::asin(std::min(1.0, perp)) * 180.0 / M_PI, 1) +
+                 " deg > " + fmt(p.perpendicular_tolerance_deg, 1);
+    } else if (v.inside_fraction < p.min_inside_fraction) {
+      v.reason = "outside the upper-shelf volume: " + fmt(v.inside_fraction, 2) + " of points inside < " +
+                 fmt(p.min_inside_fraction, 2);
+    } else if (v.width_m < p.min_width_m || v.width_m > p.max_width_m) {
+      v.reason = "width " + fmt(v.width_m) + " m not in [" + fmt(p.min_width_m) + ", " + fmt(p.max_width_m) + "]";
+    } else if (v.height_m < p.min_height_m || v.height_m > p.max_height_m) {
+      v.reason =
+          "height " + fmt(v.height_m) + " m not in [" + fmt(p.min_height_m) + ", " + fmt(p.max_height_m) + "]";
+    } else {
+      v.candidate = true;
+      if (v.centroid_base.y() < best_y) {
+        best_y = v.centroid_base.y();
+        best = r.label;
+      }
+    }
+    out.regions.push_back(std::move(v));
+  }
+  for (auto& v : out.regions)
+    if (v.candidate && v.label != best) v.reason = "candidate, not the right-most";
+  if (best == 0) {
+    out.failure_reason = seg.regions.empty() ? "no planar region" : "no region passed the book-front tests";
+    return out;
+  }
+  const PlaneRegion& r = seg.regions[size_t(best - 1)];
+  out.selected_label = best;
+  out.pi = upper_right_corner(seg.labels, best, &out.pi_fallback);
+  const Eigen::Vector3d ray((out.pi.x - g.cx) / g.fx, (out.pi.y - g.cy) / g.fy, 1.0);
+  const double denom = r.normal.dot(ray);
+  if (std::fabs(denom) > 0.05 * ray.norm()) {
+    out.p1_camera = ray * (r.offset / denom);
+  } else {
+    const cv::Vec3f q = points_camera.at<cv::Vec3f>(out.pi);
+    if (!std::isfinite(q[2])) {
+      out.failure_reason = "PI has no 3D point and its ray is parallel to the region's plane";
+      return out;
+    }
+    out.p1_camera = Eigen::Vector3d(q[0], q[1], q[2]);
+  }
+  out.p1_base = camera_in_base * out.p1_camera;
+  out.found = true;
+  return out;
+}
+
+}  // namespace bookgrasp::bws

@@ -1,0 +1,125 @@
+#pragma once
+/// @file
+/// Candidate extraction and the corner P1 (paper Section 2.1): from a planar
+/// segmentation and the stereo geometry, keep the regions that can be the
+/// front (fore-edge) of a book on the upper shelf, take the right-most one,
+/// find its upper-right image corner PI and turn it into P1 in `base`.
+///
+/// Image convention: x = column (right), y = row (down). The paper's
+/// PI = (Y_min, X_max) is the pixel (x = largest column of the region,
+/// y = smallest row of the region), i.e. the top-right corner of the region's
+/// bounding box. If that pixel is not in the region, PI is the region pixel
+/// nearest to it (Euclidean in pixels; ties: smaller row, then larger column).
+/// P1 is where the viewing ray through the centre of PI meets the region's
+/// fitted plane (so a noisy disparity at PI itself does not matter); if the
+/// ray is nearly parallel to the plane, the region's 3D point at PI is used.
+
+#include <string>
+#include <vector>
+
+#include <Eigen/Geometry>
+#include <opencv2/core.hpp>
+
+#include "services/bws_detector/disparity.h"
+#include "services/bws_detector/plane_region.h"
+
+namespace bookgrasp {
+class Config;
+}
+
+namespace bookgrasp::bws {
+
+/// The upper-shelf volume: an oriented box in `base` (later from the cart
+/// marker). Box axes: x = normal of the cart's rear board, y = along the
+/// shelf, z = normal of the shelf board (up). Books stand inside it.
+struct ShelfVolume {
+  /// Pose of the box centre and axes in `base`.
+  Eigen::Isometry3d box_in_base = Eigen::Isometry3d::Identity();
+  /// Half sizes along the box axes, metres.
+  Eigen::Vector3d half_extent = Eigen::Vector3d::Zero();
+};
+
+/// Thresholds of the book-front tests (config section `selection`).
+struct SelectionParams {
+  /// Max angle between the region normal and the rear-board normal (box x), degrees.
+  double parallel_tolerance_deg = 15.0;
+  /// Max deviation from 90 deg between the region normal and the shelf normal (box z), degrees.
+  double perpendicular_tolerance_deg = 15.0;
+  /// Width of a book front along the shelf (box y), metres: [min, max].
+  double min_width_m = 0.005;
+  /// See min_width_m.
+  double max_width_m = 0.08;
+  /// Height of a book front (box z), metres: [min, max].
+  double min_height_m = 0.08;
+  /// See min_height_m.
+  double max_height_m = 0.40;
+  /// Fraction of the region's 3D points that must lie inside the shelf volume.
+  double min_inside_fraction = 0.8;
+  /// Regions with fewer pixels are dropped before any other test.
+  int min_pixels = 30;
+  /// Extents are measured between these quantiles of the points (robust to stray pixels), e.g. 0.02.
+  double extent_quantile = 0.02;
+
+  /// Reads every key of the `selection` section.
+  static SelectionParams from_config(const Config& section);
+};
+
+/// The verdict on one region, with the measures it was judged by.
+struct RegionVerdict {
+  /// Label in the segmentation.
+  int label = 0;
+  /// True if the region passed every book-front test.
+  bool candidate = false;
+  /// Why the region was dropped (empty for a candidate).
+  std::string reason;
+  /// Plane normal in base (unit) and offset (normal . p = offset, metres).
+  Eigen::Vector3d normal_base = Eigen::Vector3d::Zero();
+  /// See normal_base.
+  double offset_base = 0.0;
+  /// Centroid of the region's points in base, metres.
+  Eigen::Vector3d centroid_base = Eigen::Vector3d::Zero();
+  /// Axis-aligned extent in base (quantiles of the points), metres.
+  Eigen::Vector3d extent_min_base = Eigen::Vector3d::Zero();
+  /// See extent_min_base.
+  Eigen::Vector3d extent_max_base = Eigen::Vector3d::Zero();
+  /// Extent along the shelf (box y) and up (box z), metres.
+  double width_m = 0.0;
+  /// See width_m.
+  double height_m = 0.0;
+  /// Fraction of the region's points inside the shelf volume.
+  double inside_fraction = 0.0;
+};
+
+/// Result of the selection.
+struct BookFrontResult {
+  /// True if a book front was found.
+  bool found = false;
+  /// Why not (empty when found).
+  std::string failure_reason;
+  /// Label of the selected region (0 if none).
+  int selected_label = 0;
+  /// PI in the left image (column, row).
+  cv::Point pi{-1, -1};
+  /// True if (Y_min, X_max) was outside the region and the nearest region pixel was taken.
+  bool pi_fallback = false;
+  /// P1 in the left camera frame and in base, metres.
+  Eigen::Vector3d p1_camera = Eigen::Vector3d::Zero();
+  /// See p1_camera.
+  Eigen::Vector3d p1_base = Eigen::Vector3d::Zero();
+  /// One verdict per region of the segmentation, in label order.
+  std::vector<RegionVerdict> regions;
+};
+
+/// The paper's PI of a region: (Y_min, X_max) or the nearest region pixel (see the file comment).
+/// `fallback` (optional) tells which case applied. Throws std::invalid_argument if the label is absent.
+cv::Point upper_right_corner(const cv::Mat& labels, int label, bool* fallback = nullptr);
+
+/// Runs the book-front tests on every region of `segmentation` (planes in the
+/// left camera frame, metres), picks the right-most candidate (smallest base y
+/// of its centroid) and computes PI and P1. `points_camera` are the left-camera
+/// points the segmentation was fitted to (CV_32FC3, metres).
+BookFrontResult select_book_front(const SegmentationResult& segmentation, const cv::Mat& points_camera,
+                                  const StereoGeometry& geometry, const Eigen::Isometry3d& camera_in_base,
+                                  const ShelfVolume& shelf, const SelectionParams& params);
+
+}  // namespace bookgrasp::bws

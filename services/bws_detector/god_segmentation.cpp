@@ -1,0 +1,399 @@
+#include "services/bws_detector/god_segmentation.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <numeric>
+#include <stdexcept>
+#include <tuple>
+#include <vector>
+
+#include "common/config.h"
+
+namespace bookgrasp::bws {
+
+namespace {
+
+/// Direction of (dx, dy) in degrees, (0, 360]; dx, dy not both zero.
+/// atan on [0, 1] by a degree-9 odd polynomial (max error ~1e-5 rad).
+inline float direction_deg(float dx, float dy) {
+  const float ax = std::fabs(dx), ay = std::fabs(dy);
+  const float mn = std::min(ax, ay), mx = std::max(ax, ay);
+  const float t = mn / mx;
+  const float s = t * t;
+  float a = t * (0.9998660f + s * (-0.3302995f + s * (0.1801410f + s * (-0.0851330f + s * 0.0208351f))));
+  a *= 57.295779513f;  // degrees, [0, 45]
+  if (ay > ax) a = 90.f - a;
+  if (dx < 0.f) a = 180.f - a;
+  if (dy < 0.f) a = -a;
+  if (a <= 0.f) a += 360.f;
+  return a;
+}
+
+inline bool valid_value(float v) { return std::isfinite(v) && v > 0.f; }
+
+struct UnionFind {
+  std::vector<int> parent;
+  explicit UnionFind(size_t n) : parent(n) { std::iota(parent.begin(), parent.end(), 0); }
+  int find(int a) {
+    while (parent[size_t(a)] != a) {
+      parent[size_t(a)] = parent[size_t(parent[size_t(a)])];
+      a = parent[size_t(a)];
+    }
+    return a;
+  }
+  /// Joins the sets; the smaller root index becomes the root (deterministic).
+  int unite(int a, int b) {
+    a = find(a);
+    b = find(b);
+    if (a == b) return a;
+    if (b < a) std::swap(a, b);
+    parent[size_t(b)] = a;
+    return a;
+  }
+};
+
+}  // namespace
+
+GodParams GodParams::from_config(const Config& c) {
+  GodParams p;
+  p.gradient_step = c.get_int("gradient_step", 1, 16);
+  p.direction_bins = c.get_int("direction_bins", 2, 254);
+  p.flat_mgod_max = c.get_double("flat_mgod_max", 0.0, 1e6);
+  p.window_size = c.get_int("window_size", 1, 101);
+  p.jump_mgod_min = c.get_double("jump_mgod_min", 0.0, 1e9);
+  p.merge_distance = c.get_double("merge_distance", 0.0, 1e9);
+  p.merge_space = c.get_choice("merge_space", {"image", "points"}) == "image" ? MergeSpace::kImage
+                                                                             : MergeSpace::kPoints;
+  p.adjacency_radius_px = c.get_int("adjacency_radius_px", 1, 16);
+  p.boundary_growth_px = c.get_int("boundary_growth_px", 0, 64);
+  p.min_region_px = c.get_int("min_region_px", 1, 10000000);
+  try {
+    p.validate();
+  } catch (const std::invalid_argument& e) {
+    throw ConfigError(c.source() + ": " + c.path_of("window_size") + ": " + e.what());
+  }
+  return p;
+}
+
+void GodParams::validate() const {
+  if (gradient_step < 1) throw std::invalid_argument("gradient_step must be >= 1");
+  if (direction_bins < 2 || direction_bins > 254) throw std::invalid_argument("direction_bins must be in [2, 254]");
+  if (window_size < 1 || window_size % 2 == 0) throw std::invalid_argument("window_size must be odd and >= 1");
+  if (!(flat_mgod_max >= 0.0)) throw std::invalid_argument("flat_mgod_max must be >= 0");
+  if (!(jump_mgod_min > flat_mgod_max)) throw std::invalid_argument("jump_mgod_min must be > flat_mgod_max");
+  if (!(merge_distance >= 0.0)) throw std::invalid_argument("merge_distance must be >= 0");
+  if (adjacency_radius_px < 1) throw std::invalid_argument("adjacency_radius_px must be >= 1");
+  if (boundary_growth_px < 0) throw std::invalid_argument("boundary_growth_px must be >= 0");
+  if (min_region_px < 1) throw std::invalid_argument("min_region_px must be >= 1");
+}
+
+GodFeatures compute_god_features(const cv::Mat& image, int s, double flat_mgod_max) {
+  if (image.type() != CV_32F) throw std::invalid_argument("compute_god_features: image must be CV_32F");
+  if (s < 1) throw std::invalid_argument("compute_god_features: gradient_step must be >= 1");
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  const float flat = float(flat_mgod_max);
+  GodFeatures f;
+  f.dgod.create(image.size(), CV_32F);
+  f.mgod.create(image.size(), CV_32F);
+  f.dgod.setTo(nan);
+  f.mgod.setTo(nan);
+  for (int y = s; y < image.rows - s; ++y) {
+    const float* up = image.ptr<float>(y - s);
+    const float* mid = image.ptr<float>(y);
+    const float* dn = image.ptr<float>(y + s);
+    float* dg = f.dgod.ptr<float>(y);
+    float* mg = f.mgod.ptr<float>(y);
+    for (int x = s; x < image.cols - s; ++x) {
+      const float r = mid[x + s], l = mid[x - s], d = dn[x], u = up[x];
+      if (!(valid_value(mid[x]) && valid_value(r) && valid_value(l) && valid_value(d) && valid_value(u))) continue;
+      const float dx = r - l, dy = d - u;
+      const float m = std::sqrt(dx * dx + dy * dy);
+      mg[x] = m;
+      dg[x] = (m <= flat) ? 0.f : direction_deg(dx, dy);
+    }
+  }
+  return f;
+}
+
+cv::Mat god_bins(const GodFeatures& f, int B, double jump_mgod_min) {
+  if (B < 2 || B > 254) throw std::invalid_argument("god_bins: direction_bins must be in [2, 254]");
+  cv::Mat bins(f.dgod.size(), CV_8U);
+  const float w = 360.f / float(B);
+  const float jump = float(jump_mgod_min);
+  for (int y = 0; y < bins.rows; ++y) {
+    const float* dg = f.dgod.ptr<float>(y);
+    const float* mg = f.mgod.ptr<float>(y);
+    uint8_t* b = bins.ptr<uint8_t>(y);
+    for (int x = 0; x < bins.cols; ++x) {
+      const float a = dg[x];
+      if (!std::isfinite(a) || !(mg[x] <= jump)) {
+        b[x] = 255;
+      } else if (a == 0.f) {
+        b[x] = uint8_t(B);
+      } else {
+        int k = int(a / w + 0.5f);
+        if (k >= B) k -= B;
+        b[x] = uint8_t(k);
+      }
+    }
+  }
+  return bins;
+}
+
+cv::Mat vote_clusters(const cv::Mat& bins, int num_bins, int n) {
+  if (bins.type() != CV_8U) throw std::invalid_argument("vote_clusters: bins must be CV_8U");
+  if (n < 1 || n % 2 == 0) throw std::invalid_argument("vote_clusters: window_size must be odd");
+  if (num_bins < 1 || num_bins > 255) throw std::invalid_argument("vote_clusters: num_bins must be in [1, 255]");
+  const int W = bins.cols, H = bins.rows, r = n / 2;
+  const int K = (num_bins + 15) / 16 * 16;  // padded for vector adds
+  std::vector<uint16_t> col(size_t(W) * size_t(K), 0);
+  auto col_update = [&](int y, int delta) {
+    const uint8_t* b = bins.ptr<uint8_t>(y);
+    for (int x = 0; x < W; ++x)
+      if (b[x] < num_bins) col[size_t(x) * size_t(K) + b[x]] = uint16_t(col[size_t(x) * size_t(K) + b[x]] + delta);
+  };
+  for (int y = 0; y <= std::min(r, H - 1); ++y) col_update(y, +1);
+  cv::Mat out(bins.size(), CV_8U, cv::Scalar(255));
+  std::vector<int32_t> hist(size_t(K), 0);
+  for (int y = 0; y < H; ++y) {
+    if (y > 0) {
+      if (y + r < H) col_update(y + r, +1);
+      if (y - r - 1 >= 0) col_update(y - r - 1, -1);
+    }
+    std::fill(hist.begin(), hist.end(), 0);
+    for (int x = 0; x <= std::min(r, W - 1); ++x) {
+      const uint16_t* c = &col[size_t(x) * size_t(K)];
+      for (int k = 0; k < K; ++k) hist[size_t(k)] += c[k];
+    }
+    const uint8_t* b = bins.ptr<uint8_t>(y);
+    uint8_t* o = out.ptr<uint8_t>(y);
+    for (int x = 0; x < W; ++x) {
+      if (b[x] < num_bins) {
+        int best = 0;
+        int32_t best_votes = hist[0];
+        for (int k = 1; k < num_bins; ++k)
+          if (hist[size_t(k)] > best_votes) {
+            best_votes = hist[size_t(k)];
+            best = k;
+          }
+        o[x] = uint8_t(best);
+      }
+      if (x + r + 1 < W) {
+        const uint16_t* c = &col[size_t(x + r + 1) * size_t(K)];
+        for (int k = 0; k < K; ++k) hist[size_t(k)] += c[k];
+      }
+      if (x - r >= 0) {
+        const uint16_t* c = &col[size_t(x - r) * size_t(K)];
+        for (int k = 0; k < K; ++k) hist[size_t(k)] -= c[k];
+      }
+    }
+  }
+  return out;
+}
+
+cv::Mat connected_regions(const cv::Mat& cls, int* count) {
+  if (cls.type() != CV_8U) throw std::invalid_argument("connected_regions: input must be CV_8U");
+  const int W = cls.cols, H = cls.rows;
+  cv::Mat lab(cls.size(), CV_32S, cv::Scalar(0));
+  UnionFind uf(1);
+  uf.parent.reserve(size_t(W) * size_t(H) / 4 + 16);
+  int next = 1;
+  for (int y = 0; y < H; ++y) {
+    const uint8_t* c = cls.ptr<uint8_t>(y);
+    const uint8_t* cu = y > 0 ? cls.ptr<uint8_t>(y - 1) : nullptr;
+    int* l = lab.ptr<int>(y);
+    const int* lu = y > 0 ? lab.ptr<int>(y - 1) : nullptr;
+    for (int x = 0; x < W; ++x) {
+      const uint8_t v = c[x];
+      if (v == 255) continue;
+      const bool left = x > 0 && c[x - 1] == v;
+      const bool up = cu && cu[x] == v;
+      if (left && up) {
+        l[x] = l[x - 1];
+        if (lu[x] != l[x - 1]) uf.unite(lu[x], l[x - 1]);
+      } else if (left) {
+        l[x] = l[x - 1];
+      } else if (up) {
+        l[x] = lu[x];
+      } else {
+        l[x] = next++;
+        uf.parent.push_back(l[x]);
+      }
+    }
+  }
+  // Compact numbering in raster order of first occurrence.
+  std::vector<int> remap(size_t(next), 0);
+  int k = 0;
+  for (int y = 0; y < H; ++y) {
+    int* l = lab.ptr<int>(y);
+    for (int x = 0; x < W; ++x) {
+      if (l[x] == 0) continue;
+      const int root = uf.find(l[x]);
+      if (remap[size_t(root)] == 0) remap[size_t(root)] = ++k;
+      l[x] = remap[size_t(root)];
+    }
+  }
+  if (count) *count = k;
+  return lab;
+}
+
+SegmentationResult segment_god(const cv::Mat& image, const cv::Mat& points, const GodParams& params,
+                               GodDebug* debug) {
+  params.validate();
+  if (image.type() != CV_32F || image.empty())
+    throw std::invalid_argument("segment_god: image must be a non-empty CV_32F depth or disparity image");
+  if (!points.empty() && (points.type() != CV_32FC3 || points.size() != image.size()))
+    throw std::invalid_argument("segment_god: points must be empty or CV_32FC3 of the image's size");
+  if (params.merge_space == MergeSpace::kPoints && points.empty())
+    throw std::invalid_argument("segment_god: merge_space 'points' needs the points image");
+
+  GodDebug local;
+  GodDebug& dbg = debug ? *debug : local;
+  dbg.features = compute_god_features(image, params.gradient_step, params.flat_mgod_max);
+  dbg.bins = god_bins(dbg.features, params.direction_bins, params.jump_mgod_min);
+  dbg.clusters = vote_clusters(dbg.bins, params.direction_bins + 1, params.window_size);
+  int count = 0;
+  dbg.initial_labels = connected_regions(dbg.clusters, &count);
+  dbg.initial_count = count;
+
+  const cv::Mat merge_pts = params.merge_space == MergeSpace::kImage ? image_space_points(image) : points;
+  const int W = image.cols, H = image.rows;
+
+  // Moments of every initial segment in merge space.
+  std::vector<PointMoments> mom(size_t(count) + 1);
+  for (int y = 0; y < H; ++y) {
+    const int* l = dbg.initial_labels.ptr<int>(y);
+    const cv::Vec3f* p = merge_pts.ptr<cv::Vec3f>(y);
+    for (int x = 0; x < W; ++x)
+      if (l[x] > 0 && std::isfinite(p[x][0]) && std::isfinite(p[x][1]) && std::isfinite(p[x][2]))
+        mom[size_t(l[x])].add(Eigen::Vector3d(p[x][0], p[x][1], p[x][2]));
+  }
+
+  // Adjacency within the Chebyshev radius (forward half of the window).
+  const int R = params.adjacency_radius_px;
+  std::vector<uint64_t> edges;
+  for (int y = 0; y < H; ++y) {
+    const int* l = dbg.initial_labels.ptr<int>(y);
+    for (int x = 0; x < W; ++x) {
+      const int a = l[x];
+      if (a == 0) continue;
+      for (int dy = 0; dy <= R && y + dy < H; ++dy) {
+        const int* ln = dbg.initial_labels.ptr<int>(y + dy);
+        for (int dx = (dy == 0 ? 1 : -R); dx <= R; ++dx) {
+          const int xx = x + dx;
+          if (xx < 0 || xx >= W) continue;
+          const int b = ln[xx];
+          if (b == 0 || b == a) continue;
+          const uint64_t lo = uint64_t(std::min(a, b)), hi = uint64_t(std::max(a, b));
+          edges.push_back((lo << 32) | hi);
+        }
+      }
+    }
+  }
+  std::sort(edges.begin(), edges.end());
+  edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
+
+  // Iterative merging: each round merges the closest admissible pairs, each region at most once,
+  // then refits; until a round merges nothing.
+  UnionFind uf(size_t(count) + 1);
+  std::vector<Plane> planes(size_t(count) + 1);
+  for (int i = 1; i <= count; ++i) planes[size_t(i)] = fit_plane(mom[size_t(i)]);
+  const double T = params.merge_distance;
+  std::vector<std::tuple<double, int, int>> cand;
+  std::vector<char> touched(size_t(count) + 1, 0);
+  dbg.merges = 0;
+  dbg.merge_rounds = 0;
+  for (;;) {
+    cand.clear();
+    std::vector<uint64_t> root_edges;
+    root_edges.reserve(edges.size());
+    for (uint64_t e : edges) {
+      int a = uf.find(int(e >> 32)), b = uf.find(int(e & 0xffffffffu));
+      if (a == b) continue;
+      if (b < a) std::swap(a, b);
+      root_edges.push_back((uint64_t(a) << 32) | uint64_t(b));
+    }
+    std::sort(root_edges.begin(), root_edges.end());
+    root_edges.erase(std::unique(root_edges.begin(), root_edges.end()), root_edges.end());
+    edges.swap(root_edges);  // adjacency between current roots only
+    for (uint64_t e : edges) {
+      const int a = int(e >> 32), b = int(e & 0xffffffffu);
+      const bool a_large = mom[size_t(a)].n >= mom[size_t(b)].n;
+      const int L = a_large ? a : b, S = a_large ? b : a;
+      if (!planes[size_t(L)].valid || mom[size_t(S)].n <= 0.0) continue;
+      const double d = rms_distance(mom[size_t(S)], planes[size_t(L)]);
+      if (d < T) cand.emplace_back(d, a, b);
+    }
+    if (cand.empty()) break;
+    ++dbg.merge_rounds;
+    std::sort(cand.begin(), cand.end());
+    std::fill(touched.begin(), touched.end(), 0);
+    for (const auto& [d, a, b] : cand) {
+      if (touched[size_t(a)] || touched[size_t(b)]) continue;
+      touched[size_t(a)] = touched[size_t(b)] = 1;
+      const int root = uf.unite(a, b);
+      const int other = root == a ? b : a;
+      mom[size_t(root)].add(mom[size_t(other)]);
+      planes[size_t(root)] = fit_plane(mom[size_t(root)]);
+      ++dbg.merges;
+    }
+  }
+
+  cv::Mat labels(image.size(), CV_32S);
+  for (int y = 0; y < H; ++y) {
+    const int* l = dbg.initial_labels.ptr<int>(y);
+    int* o = labels.ptr<int>(y);
+    for (int x = 0; x < W; ++x) o[x] = l[x] > 0 ? uf.find(l[x]) : 0;
+  }
+
+  // Boundary growth: unlabeled pixels with a valid point join the 8-neighbour region whose plane
+  // is nearest, if within merge_distance.
+  for (int g = 0; g < params.boundary_growth_px; ++g) {
+    cv::Mat next = labels.clone();
+    int grown = 0;
+    for (int y = 0; y < H; ++y) {
+      const int* l = labels.ptr<int>(y);
+      const cv::Vec3f* p = merge_pts.ptr<cv::Vec3f>(y);
+      int* o = next.ptr<int>(y);
+      for (int x = 0; x < W; ++x) {
+        if (l[x] != 0) continue;
+        const cv::Vec3f q = p[x];
+        if (!(std::isfinite(q[0]) && std::isfinite(q[1]) && std::isfinite(q[2]))) continue;
+        const Eigen::Vector3d v(q[0], q[1], q[2]);
+        int best = 0;
+        double best_d = T;
+        for (int dy = -1; dy <= 1; ++dy) {
+          const int yy = y + dy;
+          if (yy < 0 || yy >= H) continue;
+          const int* ln = labels.ptr<int>(yy);
+          for (int dx = -1; dx <= 1; ++dx) {
+            const int xx = x + dx;
+            if (xx < 0 || xx >= W) continue;
+            const int b = ln[xx];
+            if (b == 0 || b == best || !planes[size_t(b)].valid) continue;
+            const double d = std::fabs(planes[size_t(b)].normal.dot(v) - planes[size_t(b)].offset);
+            if (d < best_d || (d == best_d && best != 0 && b < best)) {
+              best_d = d;
+              best = b;
+            }
+          }
+        }
+        if (best) {
+          o[x] = best;
+          ++grown;
+        }
+      }
+    }
+    labels = next;
+    if (grown == 0) break;
+  }
+
+  const cv::Mat out_pts = points.empty() ? (params.merge_space == MergeSpace::kImage ? merge_pts
+                                                                                   : image_space_points(image))
+                                         : points;
+  return describe_regions(labels, out_pts, params.min_region_px);
+}
+
+}  // namespace bookgrasp::bws

@@ -1,0 +1,119 @@
+#pragma once
+/// @file
+/// Gradient-of-Depth (GoD) planar segmentation, paper Section 2.1 (eq. 1, 2
+/// and Figure 3): DGoD/MGoD features, voting-histogram clustering, removal of
+/// jump-edge pixels, connected regions, iterative plane merging. A pure
+/// library: works on any CV_32F depth-like image (disparity, depth, range).
+///
+/// DGoD representation (degrees, image axes: x right = column, y down = row):
+///   - NaN      : no feature (pixel or one of its four gradient neighbours invalid, or image border);
+///   - 0        : "flat", the region is parallel to the image plane (MGoD <= flat_mgod_max; the paper's 0 deg);
+///   - (0, 360] : direction atan2(dy, dx) of the gradient, full quadrant; dy = 0, dx > 0 gives exactly 360
+///                (the paper's 360 deg), so 0 never means a direction.
+/// In the voting histogram direction bins are centred on k * 360/B (bin 0 centred on 360 deg, so
+/// directions just above 0 and just below 360 share a bin) and "flat" is its own extra bin B.
+
+#include <string>
+
+#include <opencv2/core.hpp>
+
+#include "services/bws_detector/plane_region.h"
+
+namespace bookgrasp {
+class Config;
+}
+
+namespace bookgrasp::bws {
+
+/// Space in which the merge criterion's point-to-plane distance is measured.
+enum class MergeSpace {
+  /// (x, y, image value): pixels and image units (disparity pixels for a disparity image).
+  /// A 3D plane is a plane in (x, y, disparity); stereo noise is uniform in it.
+  kImage,
+  /// The caller's 3D points (e.g. metres in the camera frame).
+  kPoints,
+};
+
+/// Parameters of the GoD segmentation (all from config, section `god`).
+struct GodParams {
+  /// Gradient half-step s: dx = P(y, x+s) - P(y, x-s), dy = P(y+s, x) - P(y-s, x). The paper uses 1.
+  int gradient_step = 1;
+  /// Number of direction bins B of the voting histogram (the flat bin comes on top).
+  int direction_bins = 16;
+  /// Pixels with MGoD <= this are "flat" (DGoD = 0); 0 = only exactly zero gradients (the paper).
+  double flat_mgod_max = 0.0;
+  /// n of the n x n voting neighbourhood (odd).
+  int window_size = 7;
+  /// Pixels with MGoD > this are jump edges: they neither vote nor get a cluster (image units).
+  double jump_mgod_min = 1.0;
+  /// T_dis: two adjacent regions merge when the RMS distance of the smaller region's points to the
+  /// larger region's plane is below this (unit of merge_space).
+  double merge_distance = 0.75;
+  /// Where merge_distance is measured.
+  MergeSpace merge_space = MergeSpace::kImage;
+  /// Regions are adjacent if two of their pixels are within this Chebyshev distance (>= 1).
+  int adjacency_radius_px = 2;
+  /// After merging, unlabeled valid pixels next to a region join it (nearest plane within
+  /// merge_distance) for up to this many dilation steps; 0 disables (the paper has no such step).
+  int boundary_growth_px = 2;
+  /// Regions with fewer pixels are dropped from the output.
+  int min_region_px = 50;
+
+  /// Reads every key of the `god` section (names the key on a bad value).
+  static GodParams from_config(const Config& section);
+  /// Throws std::invalid_argument naming the field if a value is out of range.
+  void validate() const;
+};
+
+/// The two GoD components of every pixel.
+struct GodFeatures {
+  /// CV_32F DGoD in degrees (see the file comment for the representation).
+  cv::Mat dgod;
+  /// CV_32F MGoD (eq. 2, image units per 2s pixels); NaN where DGoD is NaN.
+  cv::Mat mgod;
+};
+
+/// Computes DGoD (eq. 1) and MGoD (eq. 2) of a CV_32F image; values that are
+/// non-finite or <= 0 are invalid. Angles are within 1e-3 deg of atan2 (a
+/// polynomial arctangent); axis directions (0/90/180/270/360) are exact.
+GodFeatures compute_god_features(const cv::Mat& image, int gradient_step, double flat_mgod_max);
+
+/// Histogram bin of every pixel: 0..B-1 direction, B = flat, 255 = does not vote
+/// (no feature, or MGoD > jump_mgod_min). CV_8U. B must be <= 254.
+cv::Mat god_bins(const GodFeatures& features, int direction_bins, double jump_mgod_min);
+
+/// Voting clustering: every voting pixel gets the bin with most votes in its
+/// n x n neighbourhood (ties: lowest bin); non-voting pixels stay 255. Sliding
+/// column histograms: O(N * bins), independent of n. CV_8U in, CV_8U out.
+cv::Mat vote_clusters(const cv::Mat& bins, int num_bins, int window_size);
+
+/// 4-connected components of equal values of a CV_8U image (255 = background).
+/// Returns CV_32S labels 1..count (0 background) in raster order; count in *count.
+cv::Mat connected_regions(const cv::Mat& clusters, int* count);
+
+/// Intermediate images of a GoD run, for diagnostics and tests.
+struct GodDebug {
+  /// DGoD and MGoD.
+  GodFeatures features;
+  /// Bins before voting (god_bins).
+  cv::Mat bins;
+  /// Clustered bins after voting.
+  cv::Mat clusters;
+  /// Initial segments (connected regions of the clustered image), CV_32S.
+  cv::Mat initial_labels;
+  /// Number of initial segments.
+  int initial_count = 0;
+  /// Number of merges performed.
+  int merges = 0;
+  /// Number of merge rounds until nothing merged.
+  int merge_rounds = 0;
+};
+
+/// Full GoD segmentation of `image` (CV_32F depth or disparity; invalid = NaN or <= 0).
+/// `points` (CV_32FC3, same size, NaN = invalid) are the 3D points the output planes are fitted
+/// to (and the merge space when params.merge_space == kPoints); if empty, (x, y, value) is used.
+/// Throws std::invalid_argument on a wrong type/size or bad parameters.
+SegmentationResult segment_god(const cv::Mat& image, const cv::Mat& points, const GodParams& params,
+                               GodDebug* debug = nullptr);
+
+}  // namespace bookgrasp::bws

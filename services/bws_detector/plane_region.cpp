@@ -1,0 +1,127 @@
+#include "services/bws_detector/plane_region.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+#include <Eigen/Eigenvalues>
+
+namespace bookgrasp::bws {
+
+Plane fit_plane(const PointMoments& m) {
+  Plane plane;
+  if (m.n < 3.0) return plane;
+  const Eigen::Vector3d mean = m.sum / m.n;
+  const Eigen::Matrix3d cov = m.sum_outer / m.n - mean * mean.transpose();
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(cov);
+  const Eigen::Vector3d ev = solver.eigenvalues();
+  // Degenerate (collinear or a single point): the two largest spreads must both be non-zero.
+  if (!(ev(1) > 1e-12 * std::max(1.0, ev(2)))) return plane;
+  Eigen::Vector3d n = solver.eigenvectors().col(0).normalized();
+  if (n.dot(mean) > 0.0) n = -n;
+  plane.normal = n;
+  plane.offset = n.dot(mean);
+  plane.valid = true;
+  return plane;
+}
+
+double rms_distance(const PointMoments& m, const Plane& plane) {
+  if (m.n <= 0.0) return 0.0;
+  const Eigen::Vector3d& n = plane.normal;
+  const double sq = n.dot(m.sum_outer * n) - 2.0 * plane.offset * n.dot(m.sum) + plane.offset * plane.offset * m.n;
+  return std::sqrt(std::max(0.0, sq / m.n));
+}
+
+cv::Mat image_space_points(const cv::Mat& image) {
+  if (image.type() != CV_32F) throw std::invalid_argument("image_space_points: image must be CV_32F");
+  cv::Mat pts(image.size(), CV_32FC3);
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  for (int y = 0; y < image.rows; ++y) {
+    const float* in = image.ptr<float>(y);
+    cv::Vec3f* out = pts.ptr<cv::Vec3f>(y);
+    for (int x = 0; x < image.cols; ++x) {
+      const float v = in[x];
+      out[x] = (std::isfinite(v) && v > 0.f) ? cv::Vec3f(float(x), float(y), v) : cv::Vec3f(nan, nan, nan);
+    }
+  }
+  return pts;
+}
+
+SegmentationResult describe_regions(const cv::Mat& labels, const cv::Mat& points, int min_pixels) {
+  if (labels.type() != CV_32S) throw std::invalid_argument("describe_regions: labels must be CV_32S");
+  if (points.type() != CV_32FC3 || points.size() != labels.size())
+    throw std::invalid_argument("describe_regions: points must be CV_32FC3 of the labels' size");
+  // Renumber in raster order of first pixel.
+  int max_label = 0;
+  for (int y = 0; y < labels.rows; ++y) {
+    const int* l = labels.ptr<int>(y);
+    for (int x = 0; x < labels.cols; ++x) max_label = std::max(max_label, l[x]);
+  }
+  struct Acc {
+    int pixels = 0;
+    int x0 = std::numeric_limits<int>::max(), y0 = std::numeric_limits<int>::max(), x1 = -1, y1 = -1;
+    PointMoments m;
+    Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
+    Eigen::Vector3d hi = Eigen::Vector3d::Constant(-std::numeric_limits<double>::infinity());
+    int first = -1;
+  };
+  std::vector<Acc> acc(size_t(max_label) + 1);
+  for (int y = 0; y < labels.rows; ++y) {
+    const int* l = labels.ptr<int>(y);
+    const cv::Vec3f* p = points.ptr<cv::Vec3f>(y);
+    for (int x = 0; x < labels.cols; ++x) {
+      const int lab = l[x];
+      if (lab <= 0) continue;
+      Acc& a = acc[size_t(lab)];
+      if (a.first < 0) a.first = y * labels.cols + x;
+      ++a.pixels;
+      a.x0 = std::min(a.x0, x);
+      a.x1 = std::max(a.x1, x);
+      a.y0 = std::min(a.y0, y);
+      a.y1 = std::max(a.y1, y);
+      const cv::Vec3f& q = p[x];
+      if (std::isfinite(q[0]) && std::isfinite(q[1]) && std::isfinite(q[2])) {
+        const Eigen::Vector3d v(q[0], q[1], q[2]);
+        a.m.add(v);
+        a.lo = a.lo.cwiseMin(v);
+        a.hi = a.hi.cwiseMax(v);
+      }
+    }
+  }
+  std::vector<int> order;
+  for (int lab = 1; lab <= max_label; ++lab)
+    if (acc[size_t(lab)].pixels > 0) order.push_back(lab);
+  std::sort(order.begin(), order.end(), [&](int a, int b) { return acc[size_t(a)].first < acc[size_t(b)].first; });
+
+  SegmentationResult out;
+  std::vector<int> remap(size_t(max_label) + 1, 0);
+  for (int lab : order) {
+    const Acc& a = acc[size_t(lab)];
+    if (a.pixels < min_pixels) continue;
+    const Plane plane = fit_plane(a.m);
+    if (!plane.valid) continue;
+    PlaneRegion r;
+    r.label = int(out.regions.size()) + 1;
+    r.pixel_count = a.pixels;
+    r.point_count = int(a.m.n);
+    r.bbox = cv::Rect(a.x0, a.y0, a.x1 - a.x0 + 1, a.y1 - a.y0 + 1);
+    r.normal = plane.normal;
+    r.offset = plane.offset;
+    r.centroid = a.m.sum / a.m.n;
+    r.rms_residual = rms_distance(a.m, plane);
+    r.extent_min = a.lo;
+    r.extent_max = a.hi;
+    remap[size_t(lab)] = r.label;
+    out.regions.push_back(r);
+  }
+  out.labels = cv::Mat(labels.size(), CV_32S);
+  for (int y = 0; y < labels.rows; ++y) {
+    const int* l = labels.ptr<int>(y);
+    int* o = out.labels.ptr<int>(y);
+    for (int x = 0; x < labels.cols; ++x) o[x] = l[x] > 0 ? remap[size_t(l[x])] : 0;
+  }
+  return out;
+}
+
+}  // namespace bookgrasp::bws

@@ -1,0 +1,287 @@
+// Tests of the GoD planar segmentation on synthetic images whose planes are known analytically.
+#include "services/bws_detector/god_segmentation.h"
+
+#include <cmath>
+#include <limits>
+#include <map>
+#include <set>
+
+#include <gtest/gtest.h>
+
+#include "services/bws_detector/hoover_metric.h"
+#include "synthetic_shelf.h"
+
+namespace bookgrasp::bws {
+namespace {
+
+constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
+
+// P(y, x) = c + a x + b y: a plane in any affine depth-like image (e.g. the disparity of a 3D plane).
+cv::Mat affine_image(int w, int h, double a, double b, double c) {
+  cv::Mat m(h, w, CV_32F);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) m.at<float>(y, x) = float(c + a * x + b * y);
+  return m;
+}
+
+// Expected DGoD of a plane with gradient (a, b): atan2(b, a) in (0, 360], 0 if flat.
+double expected_dgod(double a, double b) {
+  if (a == 0.0 && b == 0.0) return 0.0;
+  double deg = std::atan2(b, a) * 180.0 / M_PI;
+  if (deg <= 0.0) deg += 360.0;
+  return deg;
+}
+
+GodParams test_params() {
+  GodParams p;
+  p.gradient_step = 1;
+  p.direction_bins = 16;
+  p.flat_mgod_max = 0.0;
+  p.window_size = 5;
+  p.jump_mgod_min = 0.5;
+  p.merge_distance = 0.1;
+  p.merge_space = MergeSpace::kImage;
+  p.adjacency_radius_px = 2;
+  p.boundary_growth_px = 2;
+  p.min_region_px = 20;
+  return p;
+}
+
+TEST(GodFeatures, DgodOfKnownPlanesMatchesAtan2) {
+  // Gradients in every octant, on the axes and off them.
+  const double grads[][2] = {{0.1, 0.0},  {0.1, 0.1},   {0.0, 0.1},   {-0.1, 0.1}, {-0.1, 0.0}, {-0.1, -0.1},
+                             {0.0, -0.1}, {0.1, -0.1},  {0.03, 0.07}, {-0.2, 0.05}, {0.2, -0.011}, {0.001, 0.3}};
+  for (const auto& g : grads) {
+    const cv::Mat img = affine_image(20, 15, g[0], g[1], 50.0);
+    const GodFeatures f = compute_god_features(img, 1, 0.0);
+    const double want_mag = 2.0 * std::hypot(g[0], g[1]);  // central difference over 2 pixels
+    for (int y = 1; y < 14; ++y)
+      for (int x = 1; x < 19; ++x) {
+        // Eq. 1 in double on the image's own (float) values; the plane's analytic angle differs from
+        // it only by float rounding of the pixel values (< 0.01 deg here).
+        const double dx = double(img.at<float>(y, x + 1)) - img.at<float>(y, x - 1);
+        const double dy = double(img.at<float>(y + 1, x)) - img.at<float>(y - 1, x);
+        ASSERT_NEAR(f.dgod.at<float>(y, x), expected_dgod(dx, dy), 1e-3) << "gradient " << g[0] << "," << g[1];
+        ASSERT_NEAR(f.dgod.at<float>(y, x), expected_dgod(g[0], g[1]), 0.01);
+        ASSERT_NEAR(f.mgod.at<float>(y, x), want_mag, 1e-4);
+      }
+    // Borders have no central difference.
+    EXPECT_TRUE(std::isnan(f.dgod.at<float>(0, 5)));
+    EXPECT_TRUE(std::isnan(f.dgod.at<float>(5, 19)));
+  }
+}
+
+TEST(GodFeatures, AxisDirectionsAreExact) {
+  // dy = 0, dx > 0 is the paper's 360 deg, never 0; the other axes are exact too.
+  EXPECT_EQ(compute_god_features(affine_image(5, 5, 0.5, 0.0, 10), 1, 0).dgod.at<float>(2, 2), 360.f);
+  EXPECT_EQ(compute_god_features(affine_image(5, 5, 0.0, 0.5, 10), 1, 0).dgod.at<float>(2, 2), 90.f);
+  EXPECT_EQ(compute_god_features(affine_image(5, 5, -0.5, 0.0, 10), 1, 0).dgod.at<float>(2, 2), 180.f);
+  EXPECT_EQ(compute_god_features(affine_image(5, 5, 0.0, -0.5, 10), 1, 0).dgod.at<float>(2, 2), 270.f);
+}
+
+TEST(GodFeatures, FlatRegionIsZeroAndDistinctFrom360) {
+  // A region parallel to the image plane (constant depth): DGoD 0, MGoD 0 (paper: 0 deg).
+  const GodFeatures flat = compute_god_features(affine_image(6, 6, 0, 0, 7.0), 1, 0.0);
+  EXPECT_EQ(flat.dgod.at<float>(3, 3), 0.f);
+  EXPECT_EQ(flat.mgod.at<float>(3, 3), 0.f);
+  // dy = 0, dx > 0: 360, and in the histogram the flat bin is a different bin from direction 360.
+  const GodFeatures right = compute_god_features(affine_image(6, 6, 0.2, 0, 7.0), 1, 0.0);
+  EXPECT_EQ(right.dgod.at<float>(3, 3), 360.f);
+  const cv::Mat bf = god_bins(flat, 16, 10.0), br = god_bins(right, 16, 10.0);
+  EXPECT_EQ(bf.at<uint8_t>(3, 3), 16);  // the extra flat bin
+  EXPECT_EQ(br.at<uint8_t>(3, 3), 0);   // the direction bin centred on 360
+  // A direction just above 0 (dy slightly > 0) shares the 360 bin: the histogram is circular.
+  const GodFeatures near0 = compute_god_features(affine_image(6, 6, 0.2, 0.001, 7.0), 1, 0.0);
+  EXPECT_GT(near0.dgod.at<float>(3, 3), 0.f);
+  EXPECT_LT(near0.dgod.at<float>(3, 3), 1.f);
+  EXPECT_EQ(god_bins(near0, 16, 10.0).at<uint8_t>(3, 3), 0);
+  // flat_mgod_max > 0 turns small gradients into "flat".
+  EXPECT_EQ(compute_god_features(affine_image(6, 6, 0.01, 0.0, 7.0), 1, 0.05).dgod.at<float>(3, 3), 0.f);
+}
+
+TEST(GodFeatures, InvalidPixelsGiveNoFeature) {
+  cv::Mat img = affine_image(9, 9, 0.1, 0.2, 5.0);
+  img.at<float>(4, 4) = kNaN;
+  img.at<float>(2, 6) = 0.f;  // <= 0 is invalid too
+  const GodFeatures f = compute_god_features(img, 1, 0.0);
+  EXPECT_TRUE(std::isnan(f.dgod.at<float>(4, 4)));
+  EXPECT_TRUE(std::isnan(f.dgod.at<float>(4, 3)));  // its right neighbour is NaN
+  EXPECT_TRUE(std::isnan(f.dgod.at<float>(3, 4)));  // its lower neighbour is NaN
+  EXPECT_TRUE(std::isnan(f.dgod.at<float>(2, 5)));
+  EXPECT_FALSE(std::isnan(f.dgod.at<float>(6, 6)));
+}
+
+TEST(VoteClusters, MajorityOfTheWindowWinsAndMatchesBruteForce) {
+  // Random bins; compare the sliding-histogram result with a direct n x n count.
+  cv::Mat bins(37, 53, CV_8U);
+  cv::RNG rng(7);
+  for (int y = 0; y < bins.rows; ++y)
+    for (int x = 0; x < bins.cols; ++x) {
+      const int r = rng.uniform(0, 10);
+      bins.at<uint8_t>(y, x) = r == 9 ? 255 : uint8_t((x / 8 + y / 6 + (r < 3 ? r : 0)) % 5);
+    }
+  for (int n : {1, 3, 7, 11}) {
+    const cv::Mat out = vote_clusters(bins, 5, n);
+    for (int y = 0; y < bins.rows; ++y)
+      for (int x = 0; x < bins.cols; ++x) {
+        if (bins.at<uint8_t>(y, x) == 255) {
+          ASSERT_EQ(out.at<uint8_t>(y, x), 255);
+          continue;
+        }
+        int votes[5] = {0, 0, 0, 0, 0};
+        for (int yy = std::max(0, y - n / 2); yy <= std::min(bins.rows - 1, y + n / 2); ++yy)
+          for (int xx = std::max(0, x - n / 2); xx <= std::min(bins.cols - 1, x + n / 2); ++xx)
+            if (bins.at<uint8_t>(yy, xx) < 5) ++votes[bins.at<uint8_t>(yy, xx)];
+        int best = 0;
+        for (int k = 1; k < 5; ++k)
+          if (votes[k] > votes[best]) best = k;
+        ASSERT_EQ(out.at<uint8_t>(y, x), best) << "n=" << n << " at " << x << "," << y;
+      }
+  }
+}
+
+TEST(VoteClusters, RemovesIsolatedNoise) {
+  cv::Mat bins(20, 20, CV_8U, cv::Scalar(3));
+  bins.at<uint8_t>(10, 10) = 7;
+  bins.at<uint8_t>(4, 15) = 8;
+  const cv::Mat out = vote_clusters(bins, 17, 5);
+  EXPECT_EQ(cv::countNonZero(out != 3), 0);
+}
+
+// Two planes meeting at a crease (roof): different DGoD, no jump; must come out as two regions
+// with the planes' exact parameters.
+TEST(SegmentGod, CreaseGivesTwoRegionsWithExactPlanes) {
+  cv::Mat img(60, 80, CV_32F);
+  for (int y = 0; y < 60; ++y)
+    for (int x = 0; x < 80; ++x) img.at<float>(y, x) = float(x < 40 ? 20.0 + 0.2 * x + 0.05 * y : 36.2 - 0.2 * x + 0.05 * y);
+  const SegmentationResult r = segment_god(img, cv::Mat(), test_params());
+  ASSERT_EQ(r.regions.size(), 2u);
+  for (const PlaneRegion& reg : r.regions) {
+    // Image-space plane v = c + a x + b y has normal ~ (a, b, -1).
+    const double a = -reg.normal.x() / reg.normal.z(), b = -reg.normal.y() / reg.normal.z();
+    const bool left = reg.centroid.x() < 40;
+    EXPECT_NEAR(a, left ? 0.2 : -0.2, 1e-6);
+    EXPECT_NEAR(b, 0.05, 1e-6);
+    EXPECT_LT(reg.rms_residual, 1e-4);
+  }
+  // Every pixel is labelled, and the crease column splits them exactly (growth restores the seam).
+  EXPECT_EQ(cv::countNonZero(r.labels == 0), 0);
+  EXPECT_NE(r.labels.at<int>(30, 39), r.labels.at<int>(30, 40));
+  EXPECT_EQ(r.labels.at<int>(30, 0), r.labels.at<int>(30, 39));
+}
+
+// Two parallel planes side by side with a depth jump: same DGoD everywhere, so voting alone
+// makes one cluster; the MGoD removal of the jump pixels must separate them.
+TEST(SegmentGod, ParallelAdjacentPlanesAreSeparatedByMgodRemoval) {
+  cv::Mat img(50, 80, CV_32F);
+  for (int y = 0; y < 50; ++y)
+    for (int x = 0; x < 80; ++x) img.at<float>(y, x) = float(30.0 + 0.1 * y + (x < 40 ? 0.0 : 2.0));
+  GodParams p = test_params();
+  GodDebug dbg;
+  const SegmentationResult r = segment_god(img, cv::Mat(), p, &dbg);
+  ASSERT_EQ(r.regions.size(), 2u);
+  EXPECT_NE(r.labels.at<int>(25, 39), r.labels.at<int>(25, 40));
+  EXPECT_NEAR(std::fabs(r.regions[0].offset - r.regions[1].offset), 2.0 * std::fabs(r.regions[0].normal.z()), 1e-4);
+  // Without the removal (jump threshold above the jump's MGoD) the two planes become one initial segment.
+  p.jump_mgod_min = 100.0;
+  GodDebug dbg2;
+  segment_god(img, cv::Mat(), p, &dbg2);
+  EXPECT_EQ(dbg2.initial_count, 1);
+  EXPECT_EQ(dbg.initial_count, 2);
+}
+
+// One plane broken into many initial segments by direction noise must merge back into one;
+// a second plane 1.0 away (parallel, across a jump) must not merge at T_dis = 0.75.
+TEST(SegmentGod, MergingJoinsFragmentsOfOnePlaneButNotParallelPlanes) {
+  cv::Mat img(80, 100, CV_32F);
+  cv::RNG rng(3);
+  for (int y = 0; y < 80; ++y)
+    for (int x = 0; x < 100; ++x)
+      img.at<float>(y, x) = float(40.0 + 0.02 * x + 0.01 * y + (x >= 60 ? 1.0 : 0.0) + rng.gaussian(0.01));
+  GodParams p = test_params();
+  p.window_size = 3;   // little smoothing of directions: many initial fragments
+  p.jump_mgod_min = 0.6;
+  p.merge_distance = 0.75;
+  GodDebug dbg;
+  const SegmentationResult r = segment_god(img, cv::Mat(), p, &dbg);
+  EXPECT_GT(dbg.initial_count, 10);
+  EXPECT_GT(dbg.merges, 8);
+  ASSERT_EQ(r.regions.size(), 2u);
+  EXPECT_NE(r.labels.at<int>(40, 55), r.labels.at<int>(40, 65));
+  // Both regions cover their plane almost entirely.
+  for (const PlaneRegion& reg : r.regions) EXPECT_GT(reg.pixel_count, (reg.centroid.x() < 60 ? 60 : 40) * 80 * 0.9);
+}
+
+TEST(SegmentGod, MergeSpacePointsUsesTheCallersUnits) {
+  // Same crease, merge measured in "points" given as (x, y, 10 * value): distances scale by ~10.
+  cv::Mat img = affine_image(40, 30, 0.1, 0.0, 10.0);
+  cv::Mat pts(img.size(), CV_32FC3);
+  for (int y = 0; y < 30; ++y)
+    for (int x = 0; x < 40; ++x) pts.at<cv::Vec3f>(y, x) = cv::Vec3f(float(x), float(y), 10.f * img.at<float>(y, x));
+  GodParams p = test_params();
+  p.merge_space = MergeSpace::kPoints;
+  const SegmentationResult r = segment_god(img, pts, p);
+  ASSERT_EQ(r.regions.size(), 1u);
+  EXPECT_NEAR(-r.regions[0].normal.x() / r.regions[0].normal.z(), 1.0, 1e-6);  // fitted on the points
+  p.merge_space = MergeSpace::kPoints;
+  EXPECT_THROW(segment_god(img, cv::Mat(), p), std::invalid_argument);
+}
+
+TEST(SegmentGod, BadInputIsRejectedWithAMessage) {
+  GodParams p = test_params();
+  EXPECT_THROW(segment_god(cv::Mat(10, 10, CV_8U, cv::Scalar(1)), cv::Mat(), p), std::invalid_argument);
+  EXPECT_THROW(segment_god(cv::Mat(), cv::Mat(), p), std::invalid_argument);
+  EXPECT_THROW(segment_god(affine_image(10, 10, 0, 0, 1), cv::Mat(5, 5, CV_32FC3), p), std::invalid_argument);
+  p.window_size = 4;
+  EXPECT_THROW(segment_god(affine_image(10, 10, 0, 0, 1), cv::Mat(), p), std::invalid_argument);
+  // All-invalid image: no regions, no crash.
+  p = test_params();
+  const SegmentationResult r = segment_god(cv::Mat(20, 20, CV_32F, cv::Scalar(kNaN)), cv::Mat(), p);
+  EXPECT_TRUE(r.regions.empty());
+}
+
+// The synthetic shelf (exact disparity): GoD's segments against the rendered face ids (Hoover).
+TEST(SegmentGod, ShelfSceneSegmentsAgainstGroundTruthFaces) {
+  const test::ShelfScene scene = test::make_shelf_scene(11);
+  const test::RenderOutput ren = test::render_boxes(scene.boxes, scene.left, false);
+  const cv::Mat disp = test::exact_disparity(ren.depth, scene.left.fx, scene.baseline_m);
+  GodParams p = test_params();
+  p.window_size = 5;
+  p.jump_mgod_min = 0.6;
+  p.merge_distance = 0.75;
+  p.min_region_px = 30;
+  const SegmentationResult r = segment_god(disp, cv::Mat(), p);
+  // Ground truth: faces with at least 200 pixels (book side faces seen edge-on are slivers of
+  // 50-250 px; thin board edges of ~1.8 cm are within T_dis = 0.75 px of the board they border and
+  // merge with it by design, so the overall rate is well below 1; the book fronts are what matter).
+  cv::Mat gt = ren.face_id.clone();
+  std::map<int, int> size;
+  for (int y = 0; y < gt.rows; ++y)
+    for (int x = 0; x < gt.cols; ++x) ++size[gt.at<int>(y, x)];
+  for (int y = 0; y < gt.rows; ++y)
+    for (int x = 0; x < gt.cols; ++x)
+      if (size[gt.at<int>(y, x)] < 200) gt.at<int>(y, x) = 0;
+  const HooverScore s = hoover_compare(gt, r.labels, 0.8);
+  std::printf("GoD on exact shelf disparity, T=0.8: %d GT regions, correct %d, over %d, under %d, missed %d, noise %d\n",
+              s.gt_regions, s.correct, s.over, s.under, s.missed, s.noise);
+  EXPECT_GE(double(s.correct) / s.gt_regions, 0.6);
+  // Every book front (face -x of every book box) is a correct detection on its own at T = 0.8.
+  for (int b = scene.first_book; b < scene.first_book + scene.num_books; ++b) {
+    const int face = b * 6 + test::kFaceMinusX + 1;
+    if (size[face] < 200) continue;
+    std::map<int, int> overlap, machine_size;
+    for (int y = 0; y < gt.rows; ++y)
+      for (int x = 0; x < gt.cols; ++x) {
+        if (gt.at<int>(y, x) <= 0) continue;
+        ++machine_size[r.labels.at<int>(y, x)];
+        if (gt.at<int>(y, x) == face) ++overlap[r.labels.at<int>(y, x)];
+      }
+    bool correct = false;
+    for (const auto& [l, o] : overlap)
+      if (l > 0 && o >= 0.8 * size[face] && o >= 0.8 * machine_size[l]) correct = true;
+    EXPECT_TRUE(correct) << "front of book box " << b << " (" << size[face] << " px)";
+  }
+}
+
+}  // namespace
+}  // namespace bookgrasp::bws
