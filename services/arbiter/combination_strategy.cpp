@@ -1,0 +1,148 @@
+#include "services/arbiter/combination_strategy.h"
+
+#include <cmath>
+#include <cstdio>
+
+namespace bookgrasp {
+namespace {
+
+std::string mm(double metres) {
+  char buf[32];
+  std::snprintf(buf, sizeof(buf), "%.1f mm", metres * 1000.0);
+  return buf;
+}
+
+ValidationStep step(std::string rule, double value, double tol, bool passed, std::string decision) {
+  return ValidationStep{std::move(rule), value, tol, passed, std::move(decision)};
+}
+
+CombinationResult fail(CombinationResult r, const std::string& rule, const std::string& why) {
+  r.outcome = GraspOutcome::kNoGrasp;
+  r.steps.push_back(step(rule, NAN, NAN, false, why));
+  return r;
+}
+
+}  // namespace
+
+std::string outcome_name(GraspOutcome o) {
+  switch (o) {
+    case GraspOutcome::kGrasp: return "GRASP";
+    case GraspOutcome::kNextRegion: return "NEXT_REGION";
+    case GraspOutcome::kNoGrasp: return "NO_GRASP";
+  }
+  return "?";
+}
+
+CombinationResult validate_p1(const CombinationInputs& in, const CombinationTolerances& tol) {
+  CombinationResult r;
+  r.bwh_start = in.ps;
+  if (!in.ps.allFinite()) return fail(r, "inputs", "PS is not finite: no reference for the right-most book");
+  if (!in.p1) {
+    r.steps.push_back(step("P1.y vs PS.y", NAN, tol.p1_ps_y, false, "no P1 from BwS: ignore BwS, BwH starts from PS"));
+    return r;
+  }
+  if (!in.p1->allFinite()) {
+    r.steps.push_back(step("P1.y vs PS.y", NAN, tol.p1_ps_y, false, "P1 is not finite: ignore BwS, BwH starts from PS"));
+    return r;
+  }
+  const double d = in.p1->y() - in.ps.y();
+  if (std::abs(d) <= tol.p1_ps_y) {
+    r.p1_valid = true;
+    r.bwh_start = *in.p1;
+    r.steps.push_back(step("P1.y vs PS.y", d, tol.p1_ps_y, true, "P1 valid: BwH starts from P1"));
+  } else {
+    r.steps.push_back(step("P1.y vs PS.y", d, tol.p1_ps_y, false,
+                           "P1 invalid (" + mm(d) + " from PS, e.g. a thin book BwS missed): ignore BwS, BwH "
+                           "starts from PS"));
+  }
+  return r;
+}
+
+CombinationResult combine(const CombinationInputs& in, const CombinationTolerances& tol) {
+  CombinationResult r = validate_p1(in, tol);
+  if (r.outcome == GraspOutcome::kNoGrasp && !r.steps.empty() && r.steps.back().rule == "inputs") return r;
+  if (!in.p2) return fail(r, "P2", "no P2: BwH servoing did not converge");
+  if (!in.p2->allFinite()) return fail(r, "P2", "P2 is not finite");
+  const Eigen::Vector3d& p2 = *in.p2;
+
+  // The reference for P2: P1 when valid, else PS (the paper restarts BwH from PS).
+  const Eigen::Vector3d ref = r.p1_valid ? *in.p1 : in.ps;
+  const std::string ref_name = r.p1_valid ? "P1" : "PS";
+
+  // Y (Section 3.2).
+  double gp_y = p2.y();
+  const double dy = p2.y() - ref.y();
+  if (std::abs(dy) < tol.y) {
+    r.steps.push_back(step("P2.y vs " + ref_name + ".y", dy, tol.y, true, "P2.y valid: within the Y tolerance"));
+  } else if (dy < 0) {
+    r.steps.push_back(step("P2.y vs " + ref_name + ".y", dy, tol.y, true,
+                           "P2.y valid: " + ref_name + " lies right of P2 and BwH already delivered the right-most "
+                           "region"));
+  } else {
+    const int next = in.p2_rank + 1;
+    if (next >= tol.max_rank) {
+      return fail(r, "P2.y vs " + ref_name + ".y",
+                  "P2 lies " + mm(dy) + " right of " + ref_name + " on region " + std::to_string(in.p2_rank) +
+                      " and no further region may be tried (max_rank " + std::to_string(tol.max_rank) + ")");
+    }
+    r.steps.push_back(step("P2.y vs " + ref_name + ".y", dy, tol.y, false,
+                           "BwH chose a false region (P2 " + mm(dy) + " right of " + ref_name +
+                               "): select the next region from the right (rank " + std::to_string(next) + ")"));
+    r.outcome = GraspOutcome::kNextRegion;
+    r.next_rank = next;
+    return r;
+  }
+
+  // X (Section 3.2). Only P1 is a measurement of the book top; PS lies on the stripe.
+  double gp_x = p2.x();
+  if (r.p1_valid) {
+    const double dx = p2.x() - in.p1->x();
+    if (std::abs(dx) < tol.x) {
+      r.steps.push_back(step("P2.x vs P1.x", dx, tol.x, true, "P2.x valid: within the X tolerance"));
+    } else if (dx > 0) {
+      r.steps.push_back(step("P2.x vs P1.x", dx, tol.x, true,
+                             "P2.x valid: P2 above P1 (P1 from the point cloud cannot be above the real corner)"));
+    } else {
+      gp_x = in.p1->x();
+      r.steps.push_back(step("P2.x vs P1.x", dx, tol.x, false, "P2 is " + mm(-dx) + " below P1: use P2.x = P1.x"));
+    }
+  } else {
+    r.steps.push_back(step("P2.x vs P1.x", NAN, tol.x, true, "no valid P1: P2.x used as it is"));
+  }
+
+  // Z: GP.z = P1.z, or the book-front plane from the cart model without P1.
+  double gp_z;
+  if (r.p1_valid) {
+    gp_z = in.p1->z();
+    r.steps.push_back(step("GP.z", 0.0, 0.0, true, "GP.z = P1.z"));
+  } else if (in.front_z_fallback && std::isfinite(*in.front_z_fallback)) {
+    gp_z = *in.front_z_fallback;
+    r.steps.push_back(step("GP.z", 0.0, 0.0, true, "no valid P1: GP.z from the cart model's book-front plane"));
+  } else {
+    return fail(r, "GP.z", "no valid P1 and no book-front plane from the cart model: GP.z unknown");
+  }
+
+  r.gp = Eigen::Vector3d(gp_x, gp_y, gp_z);
+  r.outcome = GraspOutcome::kGrasp;
+  return r;
+}
+
+Eigen::Vector3d next_ps(const Eigen::Vector3d& ps, const Eigen::Vector3d& gp, double book_width) {
+  return Eigen::Vector3d(ps.x(), gp.y() - book_width, ps.z());
+}
+
+ValidationStep check_book_width(double width, const BookSizeLimits& limits) {
+  if (!std::isfinite(width) || width < 0)
+    return step("book width", width, limits.s_max(), false, "book width is not a valid measurement");
+  if (width > limits.s_max())
+    return step("book width <= S_max", width, limits.s_max(), false,
+                "book wider than S_max = L_max/2 (" + mm(limits.s_max()) +
+                    "): a gripper centred on its right edge cannot close around it");
+  if (width < limits.s_min())
+    return step("book width >= S_min", width, limits.s_min(), false,
+                "book thinner than S_min = S_max/2 (" + mm(limits.s_min()) +
+                    "): the left plate may reach the book after next");
+  return step("S_min <= book width <= S_max", width, limits.s_max(), true, "admissible book width " + mm(width));
+}
+
+}  // namespace bookgrasp

@@ -1,0 +1,93 @@
+#pragma once
+/// @file
+/// The paper's combination strategy (Section 3, Figure 8) and grasp tolerances
+/// (Section 4.1), as a pure function of points in the `grasp` frame
+/// (X up, Y right along the shelf as seen from the robot, Z into the shelf;
+/// metres). No LCM in here: the arbiter node converts messages to these inputs.
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+namespace bookgrasp {
+
+/// Tolerances of the strategy, from configuration.
+struct CombinationTolerances {
+  double p1_ps_y = 0.01;   ///< |P1.y - PS.y| for P1 to be valid ("within few millimetres")
+  double y = 0.015;        ///< grasping tolerance in Y (Section 4.1: 1.5 cm)
+  double x = 0.02;         ///< grasping tolerance in X (half the plate height: 2 cm)
+  int max_rank = 3;        ///< give up after BwH has tried this many regions from the right
+};
+
+/// One decision of the strategy, with the numbers it was made on.
+struct ValidationStep {
+  std::string rule;        ///< e.g. "P1.y vs PS.y"
+  double value = 0;        ///< the compared difference, metres
+  double tolerance = 0;    ///< metres
+  bool passed = false;     ///< the rule's condition held
+  std::string decision;    ///< what was done and why
+};
+
+/// What the strategy concluded.
+enum class GraspOutcome {
+  kGrasp,         ///< GP is valid: grasp there
+  kNextRegion,    ///< BwH chose a false region: run it again on the next region from the right
+  kNoGrasp,       ///< no grasp point can be made (reason in the last step)
+};
+
+/// Inputs of one decision. P1 from BwS (may be missing), PS from BSwH or the
+/// previous grasp, P2 from BwH servoing (may be missing when it failed).
+struct CombinationInputs {
+  std::optional<Eigen::Vector3d> p1;   ///< BwS corner, grasp frame
+  Eigen::Vector3d ps;                  ///< stripe end / expected right edge of the next book
+  std::optional<Eigen::Vector3d> p2;   ///< BwH end-effector position at convergence
+  int p2_rank = 0;                     ///< which region from the right P2 came from (0 = right-most)
+  /// Depth of the book fronts (Z) to use when P1 is invalid: the paper takes
+  /// GP.z from P1; without P1 the node supplies the front plane from the cart
+  /// model (marker + geometry). Required when p1 is missing or invalid.
+  std::optional<double> front_z_fallback;
+};
+
+/// Result: GP (grasp frame) and every step.
+struct CombinationResult {
+  GraspOutcome outcome = GraspOutcome::kNoGrasp;
+  Eigen::Vector3d gp = Eigen::Vector3d::Zero();  ///< GP = (P2.x, P2.y, P1.z) after validation
+  bool p1_valid = false;                         ///< P1 passed the PS check and was used
+  int next_rank = 0;                             ///< for kNextRegion: the rank to ask BwH for
+  /// Where BwH should start servoing: P1 if valid, else PS (Section 3.1).
+  Eigen::Vector3d bwh_start = Eigen::Vector3d::Zero();
+  std::vector<ValidationStep> steps;
+};
+
+/// Step 1 only (Section 3.1): is P1 valid against PS, and where BwH starts.
+/// Used before servoing; combine() repeats it so its trace is complete.
+CombinationResult validate_p1(const CombinationInputs& in, const CombinationTolerances& tol);
+
+/// The whole strategy: validate P1 against PS (3.1), then P2 against P1 (or PS
+/// when P1 is invalid) in Y and X (3.2), then GP = (P2.x, P2.y, P1.z).
+/// Inputs with NaN give kNoGrasp with a step naming the bad input.
+CombinationResult combine(const CombinationInputs& in, const CombinationTolerances& tol);
+
+/// The next PS after a successful grasp (Section 3): PS.y = GP.y - BW, where
+/// BW is the book width measured by the gripper plates; x and z kept from PS.
+Eigen::Vector3d next_ps(const Eigen::Vector3d& ps, const Eigen::Vector3d& gp, double book_width);
+
+/// Book-size limits of Section 4.1, from the gripper's maximum opening L_max.
+struct BookSizeLimits {
+  double l_max = 0.06;                       ///< maximum gripper opening
+  double s_max() const { return l_max / 2; } ///< widest book graspable with the gripper centred on its edge
+  double s_min() const { return s_max() / 2; }  ///< narrowest book the alternation rule assumes
+};
+
+/// Whether a book of `width` (metres) is admissible (Section 4.1): wider than
+/// S_max cannot be grasped centred on its right edge; narrower than S_min
+/// breaks the assumption that two neighbours together are at least S_max
+/// wide. Returns the step describing the check.
+ValidationStep check_book_width(double width, const BookSizeLimits& limits);
+
+/// Name of an outcome ("GRASP", "NEXT_REGION", "NO_GRASP").
+std::string outcome_name(GraspOutcome o);
+
+}  // namespace bookgrasp

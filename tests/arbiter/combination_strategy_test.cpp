@@ -1,0 +1,142 @@
+// Every branch of the combination strategy (paper Section 3) and the width limits (4.1), table-driven.
+// Expected values are worked out by hand from the paper's rules; grasp frame: X up, Y right, Z into shelf.
+#include "services/arbiter/combination_strategy.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+
+namespace bookgrasp {
+namespace {
+
+using V = Eigen::Vector3d;
+constexpr double kNan = std::numeric_limits<double>::quiet_NaN();
+
+struct Case {
+  const char* name;
+  std::optional<V> p1;
+  V ps;
+  std::optional<V> p2;
+  int rank;
+  std::optional<double> fallback_z;
+  GraspOutcome outcome;
+  bool p1_valid;
+  V gp;          // checked when outcome == kGrasp
+  int next_rank;  // checked when outcome == kNextRegion
+  const char* last_decision_contains;
+};
+
+// Tolerances as in the paper: P1-PS 1 cm ("few millimetres"), Y 1.5 cm, X 2 cm.
+const CombinationTolerances kTol{0.01, 0.015, 0.02, 3};
+const V kPs(0.00, 0.100, 0.50);
+
+const Case kCases[] = {
+    // P1 valid (0.5 cm from PS), P2 within both tolerances: GP = (P2.x, P2.y, P1.z).
+    {"all_agree", V(0.10, 0.105, 0.40), kPs, V(0.11, 0.110, 0.45), 0, {}, GraspOutcome::kGrasp, true,
+     V(0.11, 0.110, 0.40), 0, "GP.z = P1.z"},
+    // P1 valid; P2 2 cm LEFT of P1 (dy = -0.02 < 0): P2.y accepted (BwH delivered the right-most region).
+    {"p2_left_of_p1", V(0.10, 0.105, 0.40), kPs, V(0.10, 0.085, 0.45), 0, {}, GraspOutcome::kGrasp, true,
+     V(0.10, 0.085, 0.40), 0, "GP.z = P1.z"},
+    // P1 valid; P2 2 cm RIGHT of P1: false region -> next region from the right (rank 1).
+    {"p2_right_of_p1", V(0.10, 0.105, 0.40), kPs, V(0.10, 0.125, 0.45), 0, {}, GraspOutcome::kNextRegion, true,
+     V::Zero(), 1, "next region"},
+    // Same on rank 2 with max_rank 3: no region left.
+    {"p2_right_no_more_regions", V(0.10, 0.105, 0.40), kPs, V(0.10, 0.125, 0.45), 2, {}, GraspOutcome::kNoGrasp,
+     true, V::Zero(), 0, "no further region"},
+    // X: P2 3 cm above P1 (dx = +0.03): P2.x accepted.
+    {"p2_above_p1", V(0.10, 0.105, 0.40), kPs, V(0.13, 0.105, 0.45), 0, {}, GraspOutcome::kGrasp, true,
+     V(0.13, 0.105, 0.40), 0, "GP.z = P1.z"},
+    // X: P2 3 cm below P1 (dx = -0.03): P2.x = P1.x.
+    {"p2_below_p1", V(0.10, 0.105, 0.40), kPs, V(0.07, 0.105, 0.45), 0, {}, GraspOutcome::kGrasp, true,
+     V(0.10, 0.105, 0.40), 0, "GP.z = P1.z"},
+    // X: 1.9 cm below is within the 2 cm tolerance: P2.x kept.
+    {"p2_slightly_below_p1", V(0.10, 0.105, 0.40), kPs, V(0.081, 0.105, 0.45), 0, {}, GraspOutcome::kGrasp, true,
+     V(0.081, 0.105, 0.40), 0, "GP.z = P1.z"},
+    // P1 2 cm from PS (thin book missed by BwS): invalid; P2 checked against PS; Z from the cart model.
+    {"p1_invalid_uses_ps", V(0.10, 0.080, 0.40), kPs, V(0.09, 0.095, 0.45), 0, 0.42, GraspOutcome::kGrasp, false,
+     V(0.09, 0.095, 0.42), 0, "cart model"},
+    // No P1 at all, P2 fine against PS, fallback Z given.
+    {"no_p1", {}, kPs, V(0.09, 0.101, 0.45), 0, 0.41, GraspOutcome::kGrasp, false, V(0.09, 0.101, 0.41), 0,
+     "cart model"},
+    // P1 NaN is treated as missing.
+    {"p1_nan", V(kNan, 0.1, 0.4), kPs, V(0.09, 0.101, 0.45), 0, 0.41, GraspOutcome::kGrasp, false,
+     V(0.09, 0.101, 0.41), 0, "cart model"},
+    // No valid P1 and no fallback Z: GP.z unknown.
+    {"no_p1_no_fallback", {}, kPs, V(0.09, 0.101, 0.45), 0, {}, GraspOutcome::kNoGrasp, false, V::Zero(), 0,
+     "GP.z unknown"},
+    // No valid P1, P2 right of PS beyond tolerance: next region.
+    {"no_p1_p2_right_of_ps", {}, kPs, V(0.09, 0.130, 0.45), 0, 0.41, GraspOutcome::kNextRegion, false, V::Zero(), 1,
+     "next region"},
+    // BwH failed: no P2.
+    {"no_p2", V(0.10, 0.105, 0.40), kPs, {}, 0, {}, GraspOutcome::kNoGrasp, true, V::Zero(), 0, "did not converge"},
+    {"p2_nan", V(0.10, 0.105, 0.40), kPs, V(0.1, kNan, 0.4), 0, {}, GraspOutcome::kNoGrasp, true, V::Zero(), 0,
+     "not finite"},
+    {"ps_nan", V(0.10, 0.105, 0.40), V(0, kNan, 0), V(0.1, 0.1, 0.4), 0, {}, GraspOutcome::kNoGrasp, false, V::Zero(),
+     0, "PS is not finite"},
+};
+
+class CombinationStrategy : public testing::TestWithParam<Case> {};
+
+TEST_P(CombinationStrategy, Branch) {
+  const Case& c = GetParam();
+  CombinationInputs in;
+  in.p1 = c.p1;
+  in.ps = c.ps;
+  in.p2 = c.p2;
+  in.p2_rank = c.rank;
+  in.front_z_fallback = c.fallback_z;
+  const CombinationResult r = combine(in, kTol);
+  EXPECT_EQ(outcome_name(r.outcome), outcome_name(c.outcome));
+  EXPECT_EQ(r.p1_valid, c.p1_valid);
+  if (c.outcome == GraspOutcome::kGrasp) {
+    EXPECT_TRUE(r.gp.isApprox(c.gp, 1e-12)) << r.gp.transpose();
+  }
+  if (c.outcome == GraspOutcome::kNextRegion) {
+    EXPECT_EQ(r.next_rank, c.next_rank);
+  }
+  ASSERT_FALSE(r.steps.empty());
+  EXPECT_NE(r.steps.back().decision.find(c.last_decision_contains), std::string::npos) << r.steps.back().decision;
+  // BwH starts from P1 when valid, else from PS (Section 3.1).
+  EXPECT_TRUE(r.bwh_start.isApprox(c.p1_valid ? *c.p1 : c.ps) || !c.ps.allFinite());
+}
+
+INSTANTIATE_TEST_SUITE_P(Paper, CombinationStrategy, testing::ValuesIn(kCases),
+                         [](const testing::TestParamInfo<Case>& i) { return std::string(i.param.name); });
+
+TEST(CombinationStrategy, P1ValidityBoundaryAndTrace) {
+  CombinationInputs in;
+  in.ps = kPs;
+  in.p1 = V(0.1, 0.100 + 0.0099, 0.4);
+  EXPECT_TRUE(validate_p1(in, kTol).p1_valid);
+  in.p1 = V(0.1, 0.100 - 0.0101, 0.4);
+  const auto r = validate_p1(in, kTol);
+  EXPECT_FALSE(r.p1_valid);
+  ASSERT_EQ(r.steps.size(), 1u);
+  EXPECT_NEAR(r.steps[0].value, -0.0101, 1e-12);
+  EXPECT_DOUBLE_EQ(r.steps[0].tolerance, 0.01);
+}
+
+TEST(CombinationStrategy, NextPsAfterAGrasp) {
+  // GP.y = 0.105, a 2.3 cm book: the next book's right edge is expected at 0.082.
+  const V ps = next_ps(kPs, V(0.1, 0.105, 0.4), 0.023);
+  EXPECT_NEAR(ps.y(), 0.082, 1e-12);
+  EXPECT_DOUBLE_EQ(ps.x(), kPs.x());
+  EXPECT_DOUBLE_EQ(ps.z(), kPs.z());
+}
+
+TEST(BookWidth, Section41Limits) {
+  const BookSizeLimits lim{0.06};
+  EXPECT_DOUBLE_EQ(lim.s_max(), 0.03);
+  EXPECT_DOUBLE_EQ(lim.s_min(), 0.015);
+  EXPECT_TRUE(check_book_width(0.02, lim).passed);
+  EXPECT_TRUE(check_book_width(0.03, lim).passed);
+  EXPECT_FALSE(check_book_width(0.031, lim).passed);
+  EXPECT_NE(check_book_width(0.031, lim).decision.find("S_max"), std::string::npos);
+  EXPECT_FALSE(check_book_width(0.012, lim).passed);
+  EXPECT_NE(check_book_width(0.012, lim).decision.find("S_min"), std::string::npos);
+  EXPECT_FALSE(check_book_width(kNan, lim).passed);
+}
+
+}  // namespace
+}  // namespace bookgrasp
