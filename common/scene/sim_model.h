@@ -141,7 +141,7 @@ class SimModel {
   std::vector<int> book_body_;   // by book index
   std::vector<int> owner_;       // by geom id
   std::vector<int> book_qpos_;   // qpos address of each book's free joint
-  double time_offset_ = 0;       // settle time
+  double gripper_target_ = 0;    // gap the gripper moves towards (m)
 };
 
 }  // namespace bookgrasp::scene
