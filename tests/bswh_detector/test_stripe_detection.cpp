@@ -1,0 +1,150 @@
+// Tests of the BSwH core on synthetic hand images with known stripe end.
+#include <cmath>
+#include <cstdlib>
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "../bwh_detector/synthetic_hand_image.h"
+#include "common/image_conversion.h"
+#include "services/bswh_detector/stripe_detection.h"
+
+namespace bookgrasp {
+namespace {
+
+StripeDetectionParams params() {
+  const Config root = Config::load_file(std::string(BOOKGRASP_SOURCE_DIR) + "/config/services/bswh_detector.yaml");
+  return StripeDetectionParams::from_config(root.child("stripe"));
+}
+
+// Writes the image with the truth and the detection drawn when BOOKGRASP_DEBUG_IMAGES names a folder.
+void maybe_dump(const std::string& name, const cv::Mat& rgb, const test::SynthTruth& t, const StripeDetection& d) {
+  const char* dir = std::getenv("BOOKGRASP_DEBUG_IMAGES");
+  if (!dir) return;
+  cv::Mat out = rgb.clone();
+  cv::circle(out, t.stripe_end, 5, cv::Scalar(0, 255, 0), 1);
+  if (d.found) cv::line(out, d.line_start, d.line_end, cv::Scalar(255, 0, 255), 1);
+  if (d.end_found) cv::drawMarker(out, d.end, cv::Scalar(255, 0, 0), cv::MARKER_CROSS, 12, 1);
+  write_png(std::string(dir) + "/bswh_" + name + ".png", out);
+}
+
+void expect_end_within(const test::SynthScene& scene, const std::string& name, double tol_px) {
+  test::SynthTruth truth;
+  const cv::Mat img = test::render_scene(scene, &truth);
+  ASSERT_TRUE(truth.stripe_end_visible) << "bad test scene " << name;
+  const StripeDetection d = detect_stripe(img, params());
+  maybe_dump(name, img, truth, d);
+  ASSERT_TRUE(d.found) << name << ": " << d.failure_reason;
+  ASSERT_TRUE(d.end_found) << name << ": " << d.failure_reason;
+  EXPECT_LT(std::hypot(d.end.x - truth.stripe_end.x, d.end.y - truth.stripe_end.y), tol_px)
+      << name << ": detected (" << d.end.x << ", " << d.end.y << ") true (" << truth.stripe_end.x << ", "
+      << truth.stripe_end.y << ")";
+  EXPECT_NEAR(d.thickness_px, scene.stripe_thickness_px, 2.0) << name;
+  EXPECT_NEAR(d.angle_rad, scene.stripe_angle_deg * CV_PI / 180.0, 0.01) << name;
+  EXPECT_GE(d.end_edge_support, 3) << name;
+}
+
+TEST(StripeDetection, EndBehindRightMostBookWithin2px) {
+  expect_end_within(test::default_scene(), "default", 2.0);
+}
+
+TEST(StripeDetection, TiltedStripeAndLeaningBook) {
+  test::SynthScene s = test::default_scene();
+  s.stripe_angle_deg = 4.0;
+  s.stripe_y = 270;
+  for (auto& b : s.books) b.lean_deg = -3.0;
+  expect_end_within(s, "tilted", 2.0);
+}
+
+TEST(StripeDetection, ShadowAndUnevenLight) {
+  test::SynthScene s = test::default_scene();
+  s.light_gradient = 0.5;
+  s.shadows.push_back({{{0, 200}, {640, 330}, {640, 480}, {0, 480}}, 0.5, 2.0});
+  expect_end_within(s, "shadow", 2.0);
+}
+
+TEST(StripeDetection, DarkLightingOverall) {
+  test::SynthScene s = test::default_scene();
+  s.shadows.push_back({{{-5, -5}, {650, -5}, {650, 490}, {-5, 490}}, 0.35, 0.0});
+  s.noise_sigma = 3.0;
+  expect_end_within(s, "dark", 2.0);
+}
+
+TEST(StripeDetection, ThickStripeDarkCoverNextToIt) {
+  test::SynthScene s = test::default_scene();
+  s.stripe_thickness_px = 34;
+  s.books.back().cover = cv::Scalar(20, 30, 90);  // dark blue
+  expect_end_within(s, "thick_darkcover", 2.0);
+}
+
+TEST(StripeDetection, RandomScenesWithin2px) {
+  cv::RNG rng(20240611);
+  for (int i = 0; i < 20; ++i) {
+    test::SynthScene s = test::default_scene();
+    s.seed = 100 + static_cast<uint64_t>(i);
+    s.stripe_y = rng.uniform(220.0, 380.0);
+    s.stripe_angle_deg = rng.uniform(-5.0, 5.0);
+    s.stripe_thickness_px = rng.uniform(10.0, 30.0);
+    s.first_book_x = rng.uniform(-150.0, 50.0);
+    const double lean = rng.uniform(-4.0, 4.0);
+    for (auto& b : s.books) b.lean_deg = lean + rng.uniform(-0.5, 0.5);
+    s.light_gradient = rng.uniform(0.0, 0.5);
+    s.noise_sigma = rng.uniform(1.0, 4.0);
+    if (i % 2) s.shadows.push_back({{{0, rng.uniform(100.0, 250.0)}, {640, rng.uniform(200.0, 400.0)}, {640, 480}, {0, 480}}, 0.55, 1.5});
+    expect_end_within(s, "random" + std::to_string(i), 2.0);
+  }
+}
+
+TEST(StripeDetection, NoStripeGivesNotFoundWithAReason) {
+  test::SynthScene s = test::default_scene();
+  s.stripe = false;
+  test::SynthTruth truth;
+  const StripeDetection d = detect_stripe(test::render_scene(s, &truth), params());
+  EXPECT_FALSE(d.found);
+  EXPECT_FALSE(d.end_found);
+  EXPECT_NE(d.failure_reason.find("not visible"), std::string::npos) << d.failure_reason;
+}
+
+TEST(StripeDetection, StripeHiddenByBooksEverywhereIsNotFound) {
+  test::SynthScene s = test::default_scene();
+  s.first_book_x = -20;
+  for (int i = 0; i < 5; ++i) s.books.push_back(s.books[static_cast<size_t>(i)]);  // books beyond the right border
+  test::SynthTruth truth;
+  const StripeDetection d = detect_stripe(test::render_scene(s, &truth), params());
+  EXPECT_FALSE(d.found) << "found a stripe at (" << d.line_start << ")";
+  EXPECT_FALSE(d.failure_reason.empty());
+}
+
+TEST(StripeDetection, NoBookInViewMeansNoEnd) {
+  test::SynthScene s = test::default_scene();
+  s.first_book_x = -800;  // all books left of the image
+  test::SynthTruth truth;
+  const StripeDetection d = detect_stripe(test::render_scene(s, &truth), params());
+  ASSERT_TRUE(d.found) << d.failure_reason;
+  EXPECT_FALSE(d.end_found);
+  EXPECT_NE(d.failure_reason.find("border"), std::string::npos) << d.failure_reason;
+  EXPECT_NEAR(d.centre_y_at(320), s.stripe_y, 1.5);
+}
+
+TEST(StripeDetection, GreyInputWorksAndBadInputThrows) {
+  test::SynthTruth truth;
+  const cv::Mat rgb = test::render_scene(test::default_scene(), &truth);
+  cv::Mat gray;
+  cv::cvtColor(rgb, gray, cv::COLOR_RGB2GRAY);
+  const StripeDetection d = detect_stripe(gray, params());
+  ASSERT_TRUE(d.end_found) << d.failure_reason;
+  EXPECT_LT(std::hypot(d.end.x - truth.stripe_end.x, d.end.y - truth.stripe_end.y), 2.0);
+  EXPECT_THROW(detect_stripe(cv::Mat(), params()), std::invalid_argument);
+  EXPECT_THROW(detect_stripe(cv::Mat(10, 10, CV_32FC1), params()), std::invalid_argument);
+}
+
+TEST(StripeDetection, SameImageSameResult) {
+  test::SynthTruth truth;
+  const cv::Mat img = test::render_scene(test::default_scene(), &truth);
+  const StripeDetection a = detect_stripe(img, params()), b = detect_stripe(img, params());
+  EXPECT_EQ(a.end.x, b.end.x);
+  EXPECT_EQ(a.end.y, b.end.y);
+}
+
+}  // namespace
+}  // namespace bookgrasp
