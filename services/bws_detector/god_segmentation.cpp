@@ -66,8 +66,11 @@ GodParams GodParams::from_config(const Config& c) {
   p.merge_distance = c.get_double("merge_distance", 0.0, 1e9);
   p.merge_space = c.get_choice("merge_space", {"image", "points"}) == "image" ? MergeSpace::kImage
                                                                              : MergeSpace::kPoints;
+  p.merge_max_angle_deg = c.get_double("merge_max_angle_deg", 0.0, 90.0);
+  p.merge_angle_min_px = c.get_int("merge_angle_min_px", 3, 100000000);
   p.adjacency_radius_px = c.get_int("adjacency_radius_px", 1, 16);
   p.boundary_growth_px = c.get_int("boundary_growth_px", 0, 64);
+  p.boundary_growth_distance = c.get_double("boundary_growth_distance", 0.0, 1e9);
   p.min_region_px = c.get_int("min_region_px", 1, 10000000);
   try {
     p.validate();
@@ -261,15 +264,25 @@ SegmentationResult segment_god(const cv::Mat& image, const cv::Mat& points, cons
   const cv::Mat merge_pts = params.merge_space == MergeSpace::kImage ? image_space_points(image) : points;
   const int W = image.cols, H = image.rows;
 
-  // Moments of every initial segment in merge space.
-  std::vector<PointMoments> mom(size_t(count) + 1);
+  const cv::Mat out_pts = points.empty() ? (params.merge_space == MergeSpace::kImage ? merge_pts
+                                                                                   : image_space_points(image))
+                                         : points;
+  // Moments of every initial segment in merge space and in the output points' space.
+  std::vector<PointMoments> mom(size_t(count) + 1), omom(size_t(count) + 1);
+  const bool same = out_pts.data == merge_pts.data;
   for (int y = 0; y < H; ++y) {
     const int* l = dbg.initial_labels.ptr<int>(y);
     const cv::Vec3f* p = merge_pts.ptr<cv::Vec3f>(y);
-    for (int x = 0; x < W; ++x)
-      if (l[x] > 0 && std::isfinite(p[x][0]) && std::isfinite(p[x][1]) && std::isfinite(p[x][2]))
+    const cv::Vec3f* q = out_pts.ptr<cv::Vec3f>(y);
+    for (int x = 0; x < W; ++x) {
+      if (l[x] <= 0) continue;
+      if (std::isfinite(p[x][0]) && std::isfinite(p[x][1]) && std::isfinite(p[x][2]))
         mom[size_t(l[x])].add(Eigen::Vector3d(p[x][0], p[x][1], p[x][2]));
+      if (!same && std::isfinite(q[x][0]) && std::isfinite(q[x][1]) && std::isfinite(q[x][2]))
+        omom[size_t(l[x])].add(Eigen::Vector3d(q[x][0], q[x][1], q[x][2]));
+    }
   }
+  if (same) omom = mom;
 
   // Adjacency within the Chebyshev radius (forward half of the window).
   const int R = params.adjacency_radius_px;
@@ -299,7 +312,13 @@ SegmentationResult segment_god(const cv::Mat& image, const cv::Mat& points, cons
   // then refits; until a round merges nothing.
   UnionFind uf(size_t(count) + 1);
   std::vector<Plane> planes(size_t(count) + 1);
-  for (int i = 1; i <= count; ++i) planes[size_t(i)] = fit_plane(mom[size_t(i)]);
+  std::vector<Plane> oplanes(size_t(count) + 1);
+  for (int i = 1; i <= count; ++i) {
+    planes[size_t(i)] = fit_plane(mom[size_t(i)]);
+    oplanes[size_t(i)] = fit_plane(omom[size_t(i)]);
+  }
+  const double cos_gate = std::cos(params.merge_max_angle_deg * M_PI / 180.0);
+  const double gate_n = double(params.merge_angle_min_px);
   const double T = params.merge_distance;
   std::vector<std::tuple<double, int, int>> cand;
   std::vector<char> touched(size_t(count) + 1, 0);
@@ -324,7 +343,12 @@ SegmentationResult segment_god(const cv::Mat& image, const cv::Mat& points, cons
       const int L = a_large ? a : b, S = a_large ? b : a;
       if (!planes[size_t(L)].valid || mom[size_t(S)].n <= 0.0) continue;
       const double d = rms_distance(mom[size_t(S)], planes[size_t(L)]);
-      if (d < T) cand.emplace_back(d, a, b);
+      if (!(d < T)) continue;
+      if (omom[size_t(a)].n >= gate_n && omom[size_t(b)].n >= gate_n && oplanes[size_t(a)].valid &&
+          oplanes[size_t(b)].valid &&
+          std::fabs(oplanes[size_t(a)].normal.dot(oplanes[size_t(b)].normal)) < cos_gate)
+        continue;
+      cand.emplace_back(d, a, b);
     }
     if (cand.empty()) break;
     ++dbg.merge_rounds;
@@ -336,7 +360,9 @@ SegmentationResult segment_god(const cv::Mat& image, const cv::Mat& points, cons
       const int root = uf.unite(a, b);
       const int other = root == a ? b : a;
       mom[size_t(root)].add(mom[size_t(other)]);
+      omom[size_t(root)].add(omom[size_t(other)]);
       planes[size_t(root)] = fit_plane(mom[size_t(root)]);
+      oplanes[size_t(root)] = fit_plane(omom[size_t(root)]);
       ++dbg.merges;
     }
   }
@@ -363,7 +389,7 @@ SegmentationResult segment_god(const cv::Mat& image, const cv::Mat& points, cons
         if (!(std::isfinite(q[0]) && std::isfinite(q[1]) && std::isfinite(q[2]))) continue;
         const Eigen::Vector3d v(q[0], q[1], q[2]);
         int best = 0;
-        double best_d = T;
+        double best_d = params.boundary_growth_distance;
         for (int dy = -1; dy <= 1; ++dy) {
           const int yy = y + dy;
           if (yy < 0 || yy >= H) continue;
@@ -390,9 +416,6 @@ SegmentationResult segment_god(const cv::Mat& image, const cv::Mat& points, cons
     if (grown == 0) break;
   }
 
-  const cv::Mat out_pts = points.empty() ? (params.merge_space == MergeSpace::kImage ? merge_pts
-                                                                                   : image_space_points(image))
-                                         : points;
   return describe_regions(labels, out_pts, params.min_region_px);
 }
 

@@ -51,11 +51,21 @@ struct GodParams {
   double merge_distance = 0.75;
   /// Where merge_distance is measured.
   MergeSpace merge_space = MergeSpace::kImage;
+  /// Orientation gate of the merge: when both regions have at least merge_angle_min_px points, their
+  /// planes (fitted to the output points, e.g. metres) must be within this angle to merge. T_dis alone
+  /// cannot tell a thin perpendicular strip (a book's side face seen at a grazing angle, a board's edge)
+  /// from the plane it borders: its points are all within T_dis of that plane. 90 disables the gate.
+  double merge_max_angle_deg = 30.0;
+  /// See merge_max_angle_deg.
+  int merge_angle_min_px = 100;
   /// Regions are adjacent if two of their pixels are within this Chebyshev distance (>= 1).
   int adjacency_radius_px = 2;
   /// After merging, unlabeled valid pixels next to a region join it (nearest plane within
   /// merge_distance) for up to this many dilation steps; 0 disables (the paper has no such step).
   int boundary_growth_px = 2;
+  /// Max distance (merge-space unit) of a pixel to the plane of the region it grows into. Smaller than
+  /// merge_distance: grazing strips next to a plane are within T_dis of it but must not join it.
+  double boundary_growth_distance = 0.25;
   /// Regions with fewer pixels are dropped from the output.
   int min_region_px = 50;
 

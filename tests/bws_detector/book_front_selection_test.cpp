@@ -1,1 +1,208 @@
+// Book-front candidates, PI and P1 on analytically ray-cast shelf scenes (truth known to the test only).
+#include "services/bws_detector/book_front_selection.h"
+
+#include <cmath>
+#include <map>
+
 #include <gtest/gtest.h>
+
+#include "services/bws_detector/disparity.h"
+#include "services/bws_detector/god_segmentation.h"
+#include "synthetic_shelf.h"
+
+namespace bookgrasp::bws {
+namespace {
+
+TEST(UpperRightCorner, InsideTheRegionIsTheBoundingBoxCorner) {
+  cv::Mat l(10, 10, CV_32S, cv::Scalar(0));
+  l(cv::Rect(2, 3, 5, 4)).setTo(7);  // x 2..6, y 3..6
+  bool fb = true;
+  EXPECT_EQ(upper_right_corner(l, 7, &fb), cv::Point(6, 3));
+  EXPECT_FALSE(fb);
+}
+
+TEST(UpperRightCorner, FallsBackToTheNearestRegionPixel) {
+  // A parallelogram leaning left: rows 2..6, row y covers x = 8 - (y - 2) - 3 .. 8 - (y - 2).
+  // Y_min = 2, X_max = 8 (row 2 covers 3..8)... make the top row shorter instead:
+  //   row 2: x 1..4, row 3: x 1..6, row 4: x 1..8.  Y_min = 2, X_max = 8: (8, 2) not in the region.
+  //   Squared distances to (8, 2): (4,2): 16; (6,3): 4 + 1 = 5; (8,4): 0 + 4 = 4 -> PI = (8, 4).
+  cv::Mat l(8, 12, CV_32S, cv::Scalar(0));
+  l(cv::Rect(1, 2, 4, 1)).setTo(3);
+  l(cv::Rect(1, 3, 6, 1)).setTo(3);
+  l(cv::Rect(1, 4, 8, 1)).setTo(3);
+  bool fb = false;
+  EXPECT_EQ(upper_right_corner(l, 3, &fb), cv::Point(8, 4));
+  EXPECT_TRUE(fb);
+  // Tie: (7, 3) and (8, 4)... with row 3 extended to x = 7: (7,3): 1 + 1 = 2 < 4 -> PI = (7, 3).
+  l.at<int>(3, 7) = 3;
+  EXPECT_EQ(upper_right_corner(l, 3, &fb), cv::Point(7, 3));
+  EXPECT_THROW(upper_right_corner(l, 99), std::invalid_argument);
+}
+
+SelectionParams selection_params() {
+  SelectionParams p;
+  p.parallel_tolerance_deg = 15;
+  p.perpendicular_tolerance_deg = 15;
+  p.min_width_m = 0.005;
+  p.max_width_m = 0.06;
+  p.min_height_m = 0.08;
+  p.max_height_m = 0.35;
+  p.min_inside_fraction = 0.8;
+  p.min_pixels = 30;
+  p.extent_quantile = 0.02;
+  return p;
+}
+
+GodParams god_params() {
+  GodParams p;
+  p.gradient_step = 1;
+  p.direction_bins = 16;
+  p.flat_mgod_max = 0.0;
+  p.window_size = 5;
+  p.jump_mgod_min = 0.6;
+  p.merge_distance = 0.75;
+  p.merge_space = MergeSpace::kImage;
+  p.merge_max_angle_deg = 30.0;
+  p.merge_angle_min_px = 100;
+  p.adjacency_radius_px = 2;
+  p.boundary_growth_px = 2;
+  p.boundary_growth_distance = 0.25;
+  p.min_region_px = 30;
+  return p;
+}
+
+struct Outcome {
+  BookFrontResult result;
+  int true_front_label_overlap = 0;
+  bool right_book = false;
+};
+
+// Runs segmentation + selection on one scene; `disparity` from exact depth or from StereoBM.
+BookFrontResult detect(const test::ShelfScene& scene, const cv::Mat& disparity, const test::RenderOutput& ren,
+                       bool* right_book) {
+  const StereoGeometry g{scene.left.fx, scene.left.fy, scene.left.cx, scene.left.cy, scene.baseline_m};
+  const cv::Mat pts = disparity_to_points(disparity, g);
+  const SegmentationResult seg = segment_god(disparity, pts, god_params());
+  ShelfVolume shelf{scene.shelf_box_in_base, scene.shelf_half_extent};
+  BookFrontResult r = select_book_front(seg, pts, g, scene.left.in_base, shelf, selection_params());
+  if (right_book && r.found) {
+    // The selected region must be mostly the right-most book's front face (truth used only here).
+    const int face = scene.rightmost_book * 6 + test::kFaceMinusX + 1;
+    int in = 0, all = 0;
+    for (int y = 0; y < seg.labels.rows; ++y)
+      for (int x = 0; x < seg.labels.cols; ++x)
+        if (seg.labels.at<int>(y, x) == r.selected_label) {
+          ++all;
+          in += ren.face_id.at<int>(y, x) == face;
+        }
+    *right_book = in > 0.8 * all;
+  }
+  return r;
+}
+
+TEST(SelectBookFront, ExactDisparityP1WithinAFewMillimetres) {
+  for (uint32_t seed : {1u, 2u, 3u, 4u, 5u, 6u, 7u, 8u}) {
+    const test::ShelfScene scene = test::make_shelf_scene(seed);
+    const test::RenderOutput ren = test::render_boxes(scene.boxes, scene.left, false);
+    const cv::Mat disp = test::exact_disparity(ren.depth, scene.left.fx, scene.baseline_m);
+    bool right = false;
+    const BookFrontResult r = detect(scene, disp, ren, &right);
+    ASSERT_TRUE(r.found) << "seed " << seed << ": " << r.failure_reason;
+    EXPECT_TRUE(right) << "seed " << seed << ": wrong book";
+    if (!right)
+      for (const RegionVerdict& v : r.regions)
+        if (v.centroid_base.y() < scene.true_corner_base.y() + 0.06 && v.centroid_base.z() > 0.5)
+          std::printf("  region %d c=(%.3f %.3f %.3f) w=%.3f h=%.3f in=%.2f n=(%.2f %.2f %.2f): %s\n", v.label,
+                      v.centroid_base.x(), v.centroid_base.y(), v.centroid_base.z(), v.width_m, v.height_m,
+                      v.inside_fraction, v.normal_base.x(), v.normal_base.y(), v.normal_base.z(), v.reason.c_str());
+    const Eigen::Vector3d err = r.p1_base - scene.true_corner_base;
+    std::printf("seed %u: P1 error base (mm) %.1f %.1f %.1f, PI (%d, %d)%s\n", seed, 1e3 * err.x(), 1e3 * err.y(),
+                1e3 * err.z(), r.pi.x, r.pi.y, r.pi_fallback ? " (fallback)" : "");
+    // One pixel at ~1.4 m is ~2.4 mm; PI is a pixel centre inside the region, so up to ~1.5 px per axis.
+    EXPECT_LT(err.norm(), 0.006) << "seed " << seed;
+    // Every region has a verdict; exactly one is selected, the others say why not.
+    int selected = 0;
+    for (const RegionVerdict& v : r.regions) {
+      if (v.label == r.selected_label) {
+        ++selected;
+        EXPECT_TRUE(v.candidate);
+        EXPECT_TRUE(v.reason.empty());
+      } else {
+        EXPECT_FALSE(v.reason.empty());
+      }
+    }
+    EXPECT_EQ(selected, 1);
+  }
+}
+
+// End to end from textured stereo renders through StereoBM. At ~1.4 m a 1-3.5 cm book front is 4-14 px
+// wide: StereoBM smears it with the grazing side face, and the plane of so narrow a region is poorly
+// determined about the vertical axis, so the right-most front is often dropped as "not parallel"
+// (measured: right book in 1 of these 3 scenes, P1 error 3.0/2.2/0.8 mm there). What must hold:
+// a P1 is found on the front of a book (never the cart), and when it is the right book it is within 1 cm.
+TEST(SelectBookFront, StereoBmDisparitySelectsABookFront) {
+  DisparityParams dp;  // StereoBM as in config/services/bws_detector.yaml
+  dp.block_size = 7;
+  int right_count = 0;
+  for (uint32_t seed : {1u, 2u, 3u}) {
+    const test::ShelfScene scene = test::make_shelf_scene(seed);
+    const test::RenderOutput L = test::render_boxes(scene.boxes, scene.left, true);
+    const test::RenderOutput R = test::render_boxes(scene.boxes, scene.right, true);
+    const cv::Mat disp = compute_disparity(L.intensity, R.intensity, dp);
+    bool right = false;
+    const BookFrontResult r = detect(scene, disp, L, &right);
+    ASSERT_TRUE(r.found) << "seed " << seed << ": " << r.failure_reason;
+    const Eigen::Vector3d err = r.p1_base - scene.true_corner_base;
+    std::printf("StereoBM seed %u: P1 error base (mm) %.1f %.1f %.1f, right book %d\n", seed, 1e3 * err.x(),
+                1e3 * err.y(), 1e3 * err.z(), int(right));
+    // The selected region's pixels are mostly the front face of some book.
+    std::map<int, int> faces;
+    int all = 0;
+    const cv::Mat pts = disparity_to_points(disp, StereoGeometry{scene.left.fx, scene.left.fy, scene.left.cx,
+                                                                  scene.left.cy, scene.baseline_m});
+    const SegmentationResult seg = segment_god(disp, pts, god_params());
+    for (int y = 0; y < seg.labels.rows; ++y)
+      for (int x = 0; x < seg.labels.cols; ++x)
+        if (seg.labels.at<int>(y, x) == r.selected_label) {
+          ++all;
+          ++faces[L.face_id.at<int>(y, x)];
+        }
+    int best_face = 0, best_count = 0;
+    for (const auto& [f, c] : faces)
+      if (c > best_count) {
+        best_face = f;
+        best_count = c;
+      }
+    const int box = (best_face - 1) / 6, face = (best_face - 1) % 6;
+    EXPECT_GT(best_count, 0.6 * all) << "seed " << seed;
+    EXPECT_TRUE(box >= scene.first_book && box < scene.first_book + scene.num_books && face == test::kFaceMinusX)
+        << "seed " << seed << ": selected region is mostly box " << box << " face " << face;
+    if (right) {
+      ++right_count;
+      EXPECT_LT(err.norm(), 0.01) << "seed " << seed;
+    }
+  }
+  std::printf("StereoBM: right-most book in %d of 3 scenes\n", right_count);
+}
+
+TEST(SelectBookFront, NothingOnTheShelfGivesAReason) {
+  test::ShelfScene scene = test::make_shelf_scene(1);
+  scene.boxes.resize(size_t(scene.first_book));  // cart only
+  const test::RenderOutput ren = test::render_boxes(scene.boxes, scene.left, false);
+  const cv::Mat disp = test::exact_disparity(ren.depth, scene.left.fx, scene.baseline_m);
+  const BookFrontResult r = detect(scene, disp, ren, nullptr);
+  EXPECT_FALSE(r.found);
+  EXPECT_EQ(r.failure_reason, "no region passed the book-front tests");
+  for (const RegionVerdict& v : r.regions) EXPECT_FALSE(v.reason.empty());
+}
+
+TEST(SelectBookFront, BadPointsAreRejected) {
+  SegmentationResult seg;
+  seg.labels = cv::Mat(10, 10, CV_32S, cv::Scalar(0));
+  EXPECT_THROW(select_book_front(seg, cv::Mat(5, 5, CV_32FC3), StereoGeometry{}, Eigen::Isometry3d::Identity(),
+                                 ShelfVolume{}, selection_params()),
+               std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace bookgrasp::bws

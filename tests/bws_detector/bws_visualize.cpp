@@ -37,6 +37,8 @@ int main(int argc, char** argv) {
     cv::imwrite(dir + "/left.png", L.intensity);
     cv::imwrite(dir + "/right.png", R.intensity);
     DisparityParams dp;
+    if (argc > 4) dp.block_size = std::atoi(argv[4]);
+    if (argc > 5 && std::string(argv[5]) == "sgbm") dp.algorithm = StereoAlgorithm::kSemiGlobal;
     disp = compute_disparity(L.intensity, R.intensity, dp);
   } else {
     disp = test::exact_disparity(L.depth, scene.left.fx, scene.baseline_m);

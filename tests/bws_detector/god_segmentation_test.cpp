@@ -41,8 +41,11 @@ GodParams test_params() {
   p.jump_mgod_min = 0.5;
   p.merge_distance = 0.1;
   p.merge_space = MergeSpace::kImage;
+  p.merge_max_angle_deg = 30.0;
+  p.merge_angle_min_px = 100;
   p.adjacency_radius_px = 2;
   p.boundary_growth_px = 2;
+  p.boundary_growth_distance = 0.25;
   p.min_region_px = 20;
   return p;
 }
