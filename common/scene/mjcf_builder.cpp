@@ -180,13 +180,18 @@ MjcfDocument build_mjcf(const Scene& s) {
   x << "  <option timestep=\"" << num(ph.timestep_s) << "\" cone=\"elliptic\" impratio=\"" << num(ph.impratio)
     << "\" integrator=\"implicit\"/>\n";
   x << "  <size nconmax=\"3000\" njmax=\"8000\"/>\n";
+  // Fixed statistic: znear/zfar and shadow clipping scale with the extent; keep them independent of the books.
+  {
+    const Eigen::Vector3d c = s.cart_pose * Eigen::Vector3d(0, 0, 0);
+    x << "  <statistic extent=\"2\" center=\"" << vec(Eigen::Vector3d(c.x() / 2, c.y() / 2, 0.2)) << "\"/>\n";
+  }
   x << "  <visual>\n"
     << "    <global offwidth=\"" << s.render.offscreen_width << "\" offheight=\"" << s.render.offscreen_height
     << "\"/>\n"
     << "    <quality shadowsize=\"" << s.lighting.shadow_size << "\" offsamples=\"" << s.render.offsamples << "\"/>\n"
     << "    <headlight ambient=\"" << vec(Eigen::Vector3d::Constant(s.lighting.ambient))
     << "\" diffuse=\"0.08 0.08 0.08\" specular=\"0 0 0\"/>\n"
-    << "    <map znear=\"0.005\" zfar=\"20\"/>\n"
+    << "    <map znear=\"0.005\" zfar=\"10\" shadowscale=\"0.8\"/>\n"
     << "  </visual>\n";
 
   // ---- assets ----
@@ -218,9 +223,12 @@ MjcfDocument build_mjcf(const Scene& s) {
   x << "  <worldbody>\n";
   const Eigen::Vector3d centre = s.cart_pose * Eigen::Vector3d(s.shelf_depth_m / 2, 0, 0);
   const Eigen::Vector3d& dir = s.lighting.direction;
-  x << "    <light name=\"key\" directional=\"true\" castshadow=\"" << (s.lighting.shadows ? "true" : "false")
+  // Key light: a spot light 3 m away, narrow enough that its shadow map covers the cart finely
+  // (a directional light's shadow map spans the whole model and shows acne on thin books).
+  x << "    <light name=\"key\" directional=\"false\" castshadow=\"" << (s.lighting.shadows ? "true" : "false")
     << "\" pos=\"" << vec(centre - 3.0 * dir) << "\" dir=\"" << vec(dir) << "\" diffuse=\""
-    << vec(Eigen::Vector3d::Constant(s.lighting.intensity)) << "\" specular=\"0.15 0.15 0.15\"/>\n";
+    << vec(Eigen::Vector3d::Constant(s.lighting.intensity))
+    << "\" specular=\"0.15 0.15 0.15\" cutoff=\"40\" exponent=\"1\" attenuation=\"1 0 0\"/>\n";
   x << "    <geom name=\"floor\" type=\"plane\" size=\"0 0 0.05\" pos=\"0 0 " << num(s.floor_z)
     << "\" material=\"floor_mat\" " << kSceneContact << " friction=\"" << num(ph.shelf_friction) << " 0.005 0.0001\"/>\n";
   // Room walls (visual only): behind the cart and to the right.
