@@ -337,34 +337,46 @@ SegmentationResult segment_god(const cv::Mat& image, const cv::Mat& points, cons
     std::sort(root_edges.begin(), root_edges.end());
     root_edges.erase(std::unique(root_edges.begin(), root_edges.end()), root_edges.end());
     edges.swap(root_edges);  // adjacency between current roots only
-    for (uint64_t e : edges) {
-      const int a = int(e >> 32), b = int(e & 0xffffffffu);
+    // Distance of the smaller region's points to the larger region's plane, with the orientation gate;
+    // a negative value means "may not merge".
+    auto merge_cost = [&](int a, int b) {
       const bool a_large = mom[size_t(a)].n >= mom[size_t(b)].n;
       const int L = a_large ? a : b, S = a_large ? b : a;
-      if (!planes[size_t(L)].valid || mom[size_t(S)].n <= 0.0) continue;
+      if (!planes[size_t(L)].valid || mom[size_t(S)].n <= 0.0) return -1.0;
       const double d = rms_distance(mom[size_t(S)], planes[size_t(L)]);
-      if (!(d < T)) continue;
+      if (!(d < T)) return -1.0;
       if (omom[size_t(a)].n >= gate_n && omom[size_t(b)].n >= gate_n && oplanes[size_t(a)].valid &&
-          oplanes[size_t(b)].valid &&
-          std::fabs(oplanes[size_t(a)].normal.dot(oplanes[size_t(b)].normal)) < cos_gate)
-        continue;
-      cand.emplace_back(d, a, b);
+          oplanes[size_t(b)].valid && std::fabs(oplanes[size_t(a)].normal.dot(oplanes[size_t(b)].normal)) < cos_gate)
+        return -1.0;
+      return d;
+    };
+    for (uint64_t e : edges) {
+      const int a = int(e >> 32), b = int(e & 0xffffffffu);
+      const double d = merge_cost(a, b);
+      if (d >= 0.0) cand.emplace_back(d, a, b);
     }
     if (cand.empty()) break;
     ++dbg.merge_rounds;
     std::sort(cand.begin(), cand.end());
-    std::fill(touched.begin(), touched.end(), 0);
-    for (const auto& [d, a, b] : cand) {
-      if (touched[size_t(a)] || touched[size_t(b)]) continue;
-      touched[size_t(a)] = touched[size_t(b)] = 1;
+    // Closest pairs first; a pair whose regions changed in this round is re-checked with the current
+    // planes (so a region can grow several times per round, keeping the rounds few).
+    int merged_this_round = 0;
+    for (const auto& [d0, a0, b0] : cand) {
+      const int a = uf.find(a0), b = uf.find(b0);
+      if (a == b) continue;
+      if ((a != a0 || b != b0 || touched[size_t(a)] || touched[size_t(b)]) && merge_cost(a, b) < 0.0) continue;
       const int root = uf.unite(a, b);
       const int other = root == a ? b : a;
       mom[size_t(root)].add(mom[size_t(other)]);
       omom[size_t(root)].add(omom[size_t(other)]);
       planes[size_t(root)] = fit_plane(mom[size_t(root)]);
       oplanes[size_t(root)] = fit_plane(omom[size_t(root)]);
+      touched[size_t(root)] = 1;
       ++dbg.merges;
+      ++merged_this_round;
     }
+    std::fill(touched.begin(), touched.end(), 0);
+    if (merged_this_round == 0) break;
   }
 
   cv::Mat labels(image.size(), CV_32S);

@@ -1,1 +1,90 @@
-int main() { return 0; }
+// bench_bws: one 640x480 synthetic shelf stereo pair (seed 1), rendered once; every stage on the same input.
+#include <benchmark/benchmark.h>
+
+#include "services/bws_detector/book_front_selection.h"
+#include "services/bws_detector/disparity.h"
+#include "services/bws_detector/god_segmentation.h"
+#include "services/bws_detector/pcl_plane_segmentation.h"
+#include "synthetic_shelf.h"
+
+using namespace bookgrasp::bws;
+
+namespace {
+struct Input {
+  test::ShelfScene scene = test::make_shelf_scene(1);
+  cv::Mat left, right, disparity, points;
+  StereoGeometry g;
+  DisparityParams dp;
+  GodParams gp;
+  PclPlaneParams pp;
+  SelectionParams sp;
+  Input() {
+    left = test::render_boxes(scene.boxes, scene.left, true).intensity;
+    right = test::render_boxes(scene.boxes, scene.right, true).intensity;
+    dp.block_size = 7;
+    g = {scene.left.fx, scene.left.fy, scene.left.cx, scene.left.cy, scene.baseline_m};
+    disparity = compute_disparity(left, right, dp);
+    points = disparity_to_points(disparity, g);
+    gp.window_size = 5;
+    gp.jump_mgod_min = 0.6;
+    gp.min_region_px = 30;
+    pp.min_inliers = 30;
+    pp.normal_smoothing_size = 5.0;
+    pp.max_depth_change_factor = 0.01;
+    pp.angular_threshold_deg = 5.0;
+    pp.distance_threshold_m = 0.01;
+    pp.maximum_curvature = 0.01;
+    pp.min_region_px = 30;
+    sp.max_width_m = 0.06;
+    sp.max_height_m = 0.35;
+  }
+};
+Input& input() {
+  static Input in;
+  return in;
+}
+}  // namespace
+
+static void BM_Disparity_StereoBM(benchmark::State& s) {
+  auto& in = input();
+  for (auto _ : s) benchmark::DoNotOptimize(compute_disparity(in.left, in.right, in.dp));
+}
+BENCHMARK(BM_Disparity_StereoBM)->Unit(benchmark::kMillisecond);
+
+static void BM_GodFeatures(benchmark::State& s) {
+  auto& in = input();
+  for (auto _ : s) benchmark::DoNotOptimize(compute_god_features(in.disparity, 1, 0.0));
+}
+BENCHMARK(BM_GodFeatures)->Unit(benchmark::kMillisecond);
+
+static void BM_GodSegmentation(benchmark::State& s) {
+  auto& in = input();
+  GodDebug dbg;
+  for (auto _ : s) benchmark::DoNotOptimize(segment_god(in.disparity, in.points, in.gp, &dbg));
+  s.counters["initial_segments"] = dbg.initial_count;
+  s.counters["merge_rounds"] = dbg.merge_rounds;
+}
+BENCHMARK(BM_GodSegmentation)->Unit(benchmark::kMillisecond);
+
+static void BM_PclSegmentation(benchmark::State& s) {
+  auto& in = input();
+  for (auto _ : s) benchmark::DoNotOptimize(segment_pcl_planes(in.points, in.pp));
+}
+BENCHMARK(BM_PclSegmentation)->Unit(benchmark::kMillisecond);
+
+static void whole(benchmark::State& s, bool god) {
+  auto& in = input();
+  const ShelfVolume shelf{in.scene.shelf_box_in_base, in.scene.shelf_half_extent};
+  for (auto _ : s) {
+    const cv::Mat d = compute_disparity(in.left, in.right, in.dp);
+    const cv::Mat p = disparity_to_points(d, in.g);
+    const SegmentationResult seg = god ? segment_god(d, p, in.gp) : segment_pcl_planes(p, in.pp);
+    benchmark::DoNotOptimize(select_book_front(seg, p, in.g, in.scene.left.in_base, shelf, in.sp));
+  }
+}
+static void BM_WholeBwS_God(benchmark::State& s) { whole(s, true); }
+static void BM_WholeBwS_Pcl(benchmark::State& s) { whole(s, false); }
+BENCHMARK(BM_WholeBwS_God)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_WholeBwS_Pcl)->Unit(benchmark::kMillisecond);
+
+BENCHMARK_MAIN();
