@@ -1,0 +1,161 @@
+#include "services/arm_driver/arm_driver_core.h"
+
+#include <cmath>
+#include <cstdio>
+
+#include <Eigen/Dense>
+
+namespace bookgrasp {
+
+std::string driver_state_name(DriverState s) {
+  switch (s) {
+    case DriverState::kIdle: return "IDLE";
+    case DriverState::kExecuting: return "EXECUTING";
+    case DriverState::kStopped: return "STOPPED";
+    case DriverState::kFault: return "FAULT";
+  }
+  return "?";
+}
+
+ArmDriverCore::ArmDriverCore(ArmKinematics kinematics, ArmLimits limits, DriverParams params)
+    : kin_(std::move(kinematics)), limits_(std::move(limits)), params_(params) {}
+
+void ArmDriverCore::on_measurement(int64_t now_utime, const Eigen::VectorXd& q, double gripper_width) {
+  if (now_utime > now_) now_ = now_utime;
+  q_measured_ = q;
+  if (q_cmd_.size() == 0) {
+    q_cmd_ = q;
+    qd_cmd_ = Eigen::VectorXd::Zero(q.size());
+    last_heard_ = now_;
+  }
+  if (gripper_width_ < 0) gripper_width_ = gripper_width;
+}
+
+std::string ArmDriverCore::command_trajectory(const JointTrajectory& traj, int64_t id) {
+  if (!initialised()) return "no measurement of the arm yet (waiting for SIM_STATE)";
+  const std::string why = validate_trajectory(traj, q_cmd_, limits_, [this](const Eigen::VectorXd& q) {
+    return Eigen::Vector3d(kin_.tip_pose(q).translation());
+  });
+  if (!why.empty()) return why;
+  traj_ = traj;
+  traj_start_ = now_;
+  mode_ = Mode::kTrajectory;
+  state_ = DriverState::kExecuting;
+  active_id_ = id;
+  message_.clear();
+  last_heard_ = now_;
+  return "";
+}
+
+std::string ArmDriverCore::command_cartesian_velocity(const Eigen::Matrix<double, 6, 1>& twist,
+                                                      const std::string& frame, int64_t id) {
+  if (!initialised()) return "no measurement of the arm yet (waiting for SIM_STATE)";
+  if (!twist.allFinite()) return "twist is not finite (NaN or inf)";
+  if (frame != "base" && frame != "gripper") return "twist_frame must be 'base' or 'gripper', got '" + frame + "'";
+  const double v = twist.head<3>().norm(), w = twist.tail<3>().norm();
+  char buf[160];
+  if (v > limits_.max_linear_speed * (1 + limits_.relative_tolerance)) {
+    std::snprintf(buf, sizeof(buf), "linear speed %.3f m/s > limit %.3f", v, limits_.max_linear_speed);
+    return buf;
+  }
+  if (w > limits_.max_angular_speed * (1 + limits_.relative_tolerance)) {
+    std::snprintf(buf, sizeof(buf), "angular speed %.3f rad/s > limit %.3f", w, limits_.max_angular_speed);
+    return buf;
+  }
+  twist_ = twist;
+  twist_frame_ = frame;
+  mode_ = Mode::kCartesian;
+  state_ = DriverState::kExecuting;
+  active_id_ = id;
+  message_.clear();
+  last_heard_ = now_;
+  return "";
+}
+
+void ArmDriverCore::command_stop(const std::string& reason) { stop(reason); }
+
+void ArmDriverCore::heartbeat() { last_heard_ = now_; }
+
+std::string ArmDriverCore::command_gripper(double width, double force) {
+  if (!std::isfinite(width) || !std::isfinite(force)) return "gripper width/force not finite";
+  if (width < params_.gripper_min_width - 1e-9 || width > params_.gripper_max_width + 1e-9) {
+    char buf[128];
+    std::snprintf(buf, sizeof(buf), "gripper width %.4f m outside [%.4f, %.4f]", width, params_.gripper_min_width,
+                  params_.gripper_max_width);
+    return buf;
+  }
+  if (force < 0) return "gripper force must be >= 0";
+  gripper_width_ = width;
+  gripper_force_ = force > 0 ? force : params_.gripper_default_force;
+  last_heard_ = now_;
+  return "";
+}
+
+void ArmDriverCore::stop(const std::string& reason) {
+  mode_ = Mode::kHold;
+  if (qd_cmd_.size()) qd_cmd_.setZero();
+  state_ = DriverState::kStopped;
+  message_ = reason;
+}
+
+DriverSetpoint ArmDriverCore::update(int64_t now_utime) {
+  if (now_utime > now_) now_ = now_utime;
+  const double dt = last_update_ < 0 ? 0.0 : (now_ - last_update_) * 1e-6;
+  last_update_ = now_;
+  if (state_ == DriverState::kExecuting && (now_ - last_heard_) * 1e-6 > params_.heartbeat_timeout_s) {
+    char buf[128];
+    std::snprintf(buf, sizeof(buf), "no command or heartbeat for %.3f s (timeout %.3f s): stopped",
+                  (now_ - last_heard_) * 1e-6, params_.heartbeat_timeout_s);
+    stop(buf);
+  }
+  if (mode_ == Mode::kTrajectory) {
+    const double t = (now_ - traj_start_) * 1e-6;
+    sample_trajectory(traj_, t, &q_cmd_, &qd_cmd_);
+    if (t >= traj_.duration()) {
+      mode_ = Mode::kHold;
+      state_ = DriverState::kIdle;
+      qd_cmd_.setZero();
+    }
+  } else if (mode_ == Mode::kCartesian && dt > 0) {
+    Eigen::Isometry3d tip;
+    Jacobian jac;
+    kin_.tip_pose_and_jacobian(q_cmd_, tip, jac);
+    Eigen::Matrix<double, 6, 1> tw = twist_;
+    if (twist_frame_ == "gripper") {
+      tw.head<3>() = tip.linear() * twist_.head<3>();
+      tw.tail<3>() = tip.linear() * twist_.tail<3>();
+    }
+    // Damped least squares: qd = J^T (J J^T + lambda^2 I)^-1 twist.
+    const double l2 = params_.cartesian_damping * params_.cartesian_damping;
+    const Eigen::Matrix<double, 6, 6> jjt = jac * jac.transpose() + l2 * Eigen::Matrix<double, 6, 6>::Identity();
+    Eigen::VectorXd qd = jac.transpose() * jjt.ldlt().solve(tw);
+    // Scale down uniformly if a joint would exceed its velocity limit.
+    double scale = 1.0;
+    for (int j = 0; j < qd.size(); ++j)
+      if (std::abs(qd[j]) > limits_.max_velocity[j]) scale = std::min(scale, limits_.max_velocity[j] / std::abs(qd[j]));
+    qd *= scale;
+    const Eigen::VectorXd q_next = q_cmd_ + qd * dt;
+    std::string why;
+    for (int j = 0; j < q_next.size() && why.empty(); ++j)
+      if (q_next[j] < limits_.lower[j] || q_next[j] > limits_.upper[j])
+        why = "Cartesian motion reached the limit of joint " + limits_.joint_names[j] + ": stopped";
+    const Eigen::Vector3d p = kin_.tip_pose(q_next).translation();
+    if (why.empty() &&
+        ((p.array() < limits_.workspace_min.array()).any() || (p.array() > limits_.workspace_max.array()).any()))
+      why = "Cartesian motion would leave the workspace: stopped";
+    if (why.empty()) {
+      q_cmd_ = q_next;
+      qd_cmd_ = qd;
+    } else {
+      stop(why);
+    }
+  }
+  DriverSetpoint sp;
+  sp.q = q_cmd_;
+  sp.qd = qd_cmd_.size() ? qd_cmd_ : Eigen::VectorXd::Zero(q_cmd_.size());
+  sp.gripper_width = gripper_width_ < 0 ? 0.0 : gripper_width_;
+  sp.gripper_force = gripper_force_ > 0 ? gripper_force_ : params_.gripper_default_force;
+  return sp;
+}
+
+}  // namespace bookgrasp

@@ -1,0 +1,104 @@
+#pragma once
+/// @file
+/// The arm driver's logic, free of LCM: accepts or refuses commands against the
+/// limits, executes joint trajectories and Cartesian velocities in message
+/// time, stops at once on STOP or when commands/heartbeats stop arriving, and
+/// produces the joint and gripper setpoints to stream to the arm.
+
+#include <cstdint>
+#include <optional>
+#include <string>
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+#include "common/kinematics/arm_kinematics.h"
+#include "services/arm_driver/joint_trajectory.h"
+
+namespace bookgrasp {
+
+/// Driver state, as in arm_state_t.
+enum class DriverState { kIdle = 0, kExecuting = 1, kStopped = 2, kFault = 3 };
+
+/// Timing and gripper parameters of the driver.
+struct DriverParams {
+  double heartbeat_timeout_s = 0.5;   ///< stop when no command/heartbeat for this long (message time)
+  double cartesian_damping = 0.01;    ///< damped least squares lambda for Cartesian velocity
+  double gripper_max_width = 0.0602;  ///< m
+  double gripper_min_width = 0.0;     ///< m
+  double gripper_default_force = 100; ///< N, used when a command gives 0
+};
+
+/// What to send to the arm now.
+struct DriverSetpoint {
+  Eigen::VectorXd q;        ///< joint positions (rad)
+  Eigen::VectorXd qd;       ///< joint velocities (rad/s)
+  double gripper_width = 0; ///< m
+  double gripper_force = 0; ///< N
+};
+
+/// The arm driver's state machine.
+class ArmDriverCore {
+ public:
+  /// `kinematics` gives FK/Jacobian for workspace checks and Cartesian motion.
+  ArmDriverCore(ArmKinematics kinematics, ArmLimits limits, DriverParams params);
+
+  /// New measurement of the arm at message time `now_utime` (from SIM_STATE or the hardware).
+  /// The first one initialises the setpoint to where the arm is.
+  void on_measurement(int64_t now_utime, const Eigen::VectorXd& q, double gripper_width);
+
+  /// Executes `traj` from now. Returns "" if accepted, else why not (nothing changes then).
+  std::string command_trajectory(const JointTrajectory& traj, int64_t command_id);
+  /// Moves the TCP with `twist` (vx vy vz wx wy wz) in `frame` ("base" or "gripper"). "" if accepted.
+  std::string command_cartesian_velocity(const Eigen::Matrix<double, 6, 1>& twist, const std::string& frame,
+                                         int64_t command_id);
+  /// Stops at once: the setpoint holds the current commanded position.
+  void command_stop(const std::string& reason);
+  /// A heartbeat: proves the commander is alive.
+  void heartbeat();
+  /// Gripper: move to `width` (m) with `force` (N; 0 = default). "" if accepted.
+  std::string command_gripper(double width, double force);
+
+  /// Advances to `now_utime` (message time) and returns the setpoint to stream.
+  /// Ends trajectories, integrates Cartesian velocity, enforces the heartbeat.
+  DriverSetpoint update(int64_t now_utime);
+
+  /// Current state.
+  DriverState state() const { return state_; }
+  /// Reason of the last stop, refusal or fault ("" if none).
+  const std::string& message() const { return message_; }
+  /// Id of the command being executed (or last executed).
+  int64_t active_command_id() const { return active_id_; }
+  /// True once a measurement has been received.
+  bool initialised() const { return q_cmd_.size() > 0; }
+  /// The kinematics.
+  const ArmKinematics& kinematics() const { return kin_; }
+  /// The limits.
+  const ArmLimits& limits() const { return limits_; }
+
+ private:
+  enum class Mode { kHold, kTrajectory, kCartesian };
+  void stop(const std::string& reason);
+
+  ArmKinematics kin_;
+  ArmLimits limits_;
+  DriverParams params_;
+  DriverState state_ = DriverState::kIdle;
+  Mode mode_ = Mode::kHold;
+  std::string message_;
+  int64_t active_id_ = 0;
+  int64_t now_ = 0;
+  int64_t last_update_ = -1;
+  int64_t last_heard_ = 0;
+  Eigen::VectorXd q_measured_, q_cmd_, qd_cmd_;
+  JointTrajectory traj_;
+  int64_t traj_start_ = 0;
+  Eigen::Matrix<double, 6, 1> twist_ = Eigen::Matrix<double, 6, 1>::Zero();
+  std::string twist_frame_ = "base";
+  double gripper_width_ = -1, gripper_force_ = 0;
+};
+
+/// Name of a driver state ("IDLE", "EXECUTING", "STOPPED", "FAULT").
+std::string driver_state_name(DriverState s);
+
+}  // namespace bookgrasp

@@ -1,0 +1,168 @@
+#include "services/arm_driver/arm_driver_core.h"
+
+#include <gtest/gtest.h>
+
+namespace bookgrasp {
+namespace {
+
+ArmDriverCore make_core() {
+  ArmKinematics kin = ArmKinematics::from_urdf_file(std::string(BOOKGRASP_SOURCE_DIR) + "/config/robot/lwa3_pg70.urdf",
+                                                    "base", "gripper");
+  ArmLimits l;
+  l.joint_names = kin.joint_names();
+  l.lower = kin.lower_limits();
+  l.upper = kin.upper_limits();
+  l.max_velocity = kin.velocity_limits() * 0.5;
+  l.max_acceleration = Eigen::VectorXd::Constant(7, 2.0);
+  l.workspace_min = Eigen::Vector3d(-0.35, -0.95, -0.75);
+  l.workspace_max = Eigen::Vector3d(1.15, 0.95, 1.3);
+  l.start_tolerance = 0.03;
+  l.max_linear_speed = 0.15;
+  l.max_angular_speed = 0.6;
+  DriverParams p;
+  p.heartbeat_timeout_s = 0.5;
+  return ArmDriverCore(std::move(kin), l, p);
+}
+
+// A bent, well-conditioned start posture.
+Eigen::VectorXd home() {
+  Eigen::VectorXd q(7);
+  q << 0.0, 0.6, 0.0, 1.2, 0.0, 0.6, 0.0;
+  return q;
+}
+
+JointTrajectory move(const Eigen::VectorXd& from, const Eigen::VectorXd& to, double duration) {
+  JointTrajectory t;
+  const int n = 21;
+  for (int i = 0; i < n; ++i) {
+    const double s = static_cast<double>(i) / (n - 1);
+    // Smooth s-curve 3s^2 - 2s^3 and its derivative.
+    const double p = 3 * s * s - 2 * s * s * s, dp = (6 * s - 6 * s * s) / duration;
+    t.times.push_back(s * duration);
+    t.positions.push_back(from + p * (to - from));
+    t.velocities.push_back(dp * (to - from));
+  }
+  return t;
+}
+
+constexpr int64_t kT0 = 1000000000;
+
+TEST(ArmDriverCore, RefusesCommandsBeforeAnyMeasurement) {
+  ArmDriverCore d = make_core();
+  EXPECT_NE(d.command_trajectory(move(home(), home(), 1.0), 1).find("no measurement"), std::string::npos);
+}
+
+TEST(ArmDriverCore, ExecutesATrajectoryToItsGoal) {
+  ArmDriverCore d = make_core();
+  d.on_measurement(kT0, home(), 0.06);
+  Eigen::VectorXd goal = home();
+  goal[0] += 0.4;
+  goal[3] -= 0.3;
+  ASSERT_EQ(d.command_trajectory(move(home(), goal, 2.0), 7), "");
+  EXPECT_EQ(d.state(), DriverState::kExecuting);
+  DriverSetpoint sp;
+  for (int64_t t = kT0; t <= kT0 + 2500000; t += 10000) {
+    if ((t - kT0) % 100000 == 0) d.heartbeat();
+    sp = d.update(t);
+    if (t == kT0 + 1000000) {
+      // Halfway in time the s-curve is halfway in space.
+      EXPECT_NEAR(sp.q[0], home()[0] + 0.2, 1e-9);
+    }
+  }
+  EXPECT_EQ(d.state(), DriverState::kIdle);
+  EXPECT_LT((sp.q - goal).cwiseAbs().maxCoeff(), 1e-12);
+  EXPECT_EQ(sp.qd.norm(), 0.0);
+  EXPECT_EQ(d.active_command_id(), 7);
+}
+
+TEST(ArmDriverCore, StopsWhenHeartbeatsStop) {
+  ArmDriverCore d = make_core();
+  d.on_measurement(kT0, home(), 0.06);
+  Eigen::VectorXd goal = home();
+  goal[0] += 0.8;
+  ASSERT_EQ(d.command_trajectory(move(home(), goal, 4.0), 1), "");
+  DriverSetpoint sp;
+  for (int64_t t = kT0; t <= kT0 + 2000000; t += 10000) sp = d.update(t);
+  EXPECT_EQ(d.state(), DriverState::kStopped);
+  EXPECT_NE(d.message().find("heartbeat"), std::string::npos) << d.message();
+  // Stopped just after 0.5 s of message time: far from the goal, at rest, holding.
+  EXPECT_LT(sp.q[0], home()[0] + 0.1);
+  EXPECT_EQ(sp.qd.norm(), 0.0);
+  const DriverSetpoint later = d.update(kT0 + 3000000);
+  EXPECT_EQ(later.q, sp.q);
+}
+
+TEST(ArmDriverCore, StopsAtOnceOnStop) {
+  ArmDriverCore d = make_core();
+  d.on_measurement(kT0, home(), 0.06);
+  Eigen::VectorXd goal = home();
+  goal[1] += 0.5;
+  ASSERT_EQ(d.command_trajectory(move(home(), goal, 2.0), 1), "");
+  d.update(kT0 + 300000);
+  d.heartbeat();
+  const DriverSetpoint before = d.update(kT0 + 400000);
+  d.command_stop("operator");
+  EXPECT_EQ(d.state(), DriverState::kStopped);
+  const DriverSetpoint after = d.update(kT0 + 410000);
+  EXPECT_EQ(after.q, before.q) << "the setpoint freezes where it was";
+  EXPECT_EQ(after.qd.norm(), 0.0);
+}
+
+TEST(ArmDriverCore, CartesianVelocityMovesTheGripperAsCommanded) {
+  ArmDriverCore d = make_core();
+  d.on_measurement(kT0, home(), 0.06);
+  const Eigen::Vector3d p0 = d.kinematics().tip_pose(home()).translation();
+  Eigen::Matrix<double, 6, 1> tw;
+  tw << 0.02, -0.01, 0.0, 0, 0, 0;  // 2 cm/s forward, 1 cm/s to the right
+  ASSERT_EQ(d.command_cartesian_velocity(tw, "base", 3), "");
+  DriverSetpoint sp;
+  d.update(kT0);
+  for (int64_t t = kT0 + 10000; t <= kT0 + 1000000; t += 10000) {
+    d.heartbeat();
+    sp = d.update(t);
+  }
+  const Eigen::Vector3d p1 = d.kinematics().tip_pose(sp.q).translation();
+  EXPECT_NEAR(p1.x() - p0.x(), 0.02, 0.001);
+  EXPECT_NEAR(p1.y() - p0.y(), -0.01, 0.001);
+  EXPECT_NEAR(p1.z() - p0.z(), 0.0, 0.001);
+  EXPECT_EQ(d.state(), DriverState::kExecuting);
+}
+
+TEST(ArmDriverCore, BadCartesianAndGripperCommandsAreRefused) {
+  ArmDriverCore d = make_core();
+  d.on_measurement(kT0, home(), 0.06);
+  Eigen::Matrix<double, 6, 1> tw = Eigen::Matrix<double, 6, 1>::Zero();
+  tw[0] = 0.5;
+  EXPECT_NE(d.command_cartesian_velocity(tw, "base", 1).find("linear speed 0.500 m/s > limit 0.150"),
+            std::string::npos);
+  tw.setZero();
+  tw[5] = 2.0;
+  EXPECT_NE(d.command_cartesian_velocity(tw, "base", 1).find("angular speed"), std::string::npos);
+  tw[5] = NAN;
+  EXPECT_NE(d.command_cartesian_velocity(tw, "base", 1).find("not finite"), std::string::npos);
+  tw.setZero();
+  EXPECT_NE(d.command_cartesian_velocity(tw, "camera", 1).find("twist_frame"), std::string::npos);
+  EXPECT_EQ(d.state(), DriverState::kIdle) << "refused commands change nothing";
+  EXPECT_NE(d.command_gripper(0.08, 10).find("outside"), std::string::npos);
+  EXPECT_NE(d.command_gripper(NAN, 10).find("not finite"), std::string::npos);
+  EXPECT_EQ(d.command_gripper(0.03, 0), "");
+  EXPECT_DOUBLE_EQ(d.update(kT0 + 1000).gripper_width, 0.03);
+}
+
+TEST(ArmDriverCore, CartesianMotionStopsAtTheWorkspaceBoundary) {
+  ArmDriverCore d = make_core();
+  d.on_measurement(kT0, home(), 0.06);
+  Eigen::Matrix<double, 6, 1> tw = Eigen::Matrix<double, 6, 1>::Zero();
+  tw[2] = -0.15;  // straight down at full speed until the floor of the workspace
+  ASSERT_EQ(d.command_cartesian_velocity(tw, "base", 1), "");
+  for (int64_t t = kT0; t <= kT0 + 20000000 && d.state() == DriverState::kExecuting; t += 10000) {
+    d.heartbeat();
+    d.update(t);
+  }
+  EXPECT_EQ(d.state(), DriverState::kStopped);
+  EXPECT_TRUE(d.message().find("workspace") != std::string::npos || d.message().find("limit") != std::string::npos)
+      << d.message();
+}
+
+}  // namespace
+}  // namespace bookgrasp
