@@ -1,5 +1,7 @@
 #include "common/sim_render/sensor_model.h"
 
+#include <cmath>
+
 namespace bookgrasp::sim_render {
 namespace {
 
@@ -31,13 +33,34 @@ cv::Mat apply_sensor_model(const cv::Mat& rgb, const SensorModel& sensor, uint64
     rgb.convertTo(out, CV_8UC3, sensor.exposure_gain, sensor.black_level);
     return out;
   }
-  cv::Mat noise(rgb.size(), CV_32FC3);
-  cv::RNG rng(seed);
-  rng.fill(noise, cv::RNG::NORMAL, cv::Scalar::all(sensor.black_level), cv::Scalar::all(sensor.noise_stddev));
-  cv::Mat value;
-  rgb.convertTo(value, CV_32FC3, sensor.exposure_gain);
-  value += noise;
-  value.convertTo(out, CV_8UC3);  // rounds and saturates to 0..255
+  // Gain and black level through a table; the noise of each value is the sum
+  // of four 16-bit uniforms of one 64-bit draw (Irwin-Hall, mean and variance
+  // exactly those of the Gaussian it stands for): ~10x faster than
+  // cv::RNG::fill(NORMAL), which cost ~20 ms per VGA frame.
+  float level[256];
+  for (int i = 0; i < 256; ++i) level[i] = static_cast<float>(sensor.exposure_gain * i + sensor.black_level);
+  const double kMean = 4.0 * 32767.5;
+  const double kStd = std::sqrt(4.0 * (65536.0 * 65536.0 - 1.0) / 12.0);
+  const float scale = static_cast<float>(sensor.noise_stddev / kStd);
+  const float offset = static_cast<float>(-kMean * sensor.noise_stddev / kStd);
+  out.create(rgb.size(), CV_8UC3);
+  uint64_t state = splitmix64(seed);
+  for (int r = 0; r < rgb.rows; ++r) {
+    const uint8_t* src = rgb.ptr<uint8_t>(r);
+    uint8_t* dst = out.ptr<uint8_t>(r);
+    const int n = rgb.cols * 3;
+    for (int i = 0; i < n; ++i) {
+      // xorshift64* step
+      state ^= state >> 12;
+      state ^= state << 25;
+      state ^= state >> 27;
+      const uint64_t x = state * 0x2545F4914F6CDD1Dull;
+      const uint32_t sum = static_cast<uint32_t>(x & 0xFFFF) + static_cast<uint32_t>((x >> 16) & 0xFFFF) +
+                           static_cast<uint32_t>((x >> 32) & 0xFFFF) + static_cast<uint32_t>(x >> 48);
+      const float v = level[src[i]] + static_cast<float>(sum) * scale + offset;
+      dst[i] = v <= 0.0f ? 0 : v >= 255.0f ? 255 : static_cast<uint8_t>(v + 0.5f);
+    }
+  }
   return out;
 }
 

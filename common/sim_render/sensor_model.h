@@ -22,7 +22,8 @@ struct SensorModel {
 /// frame's time and the camera name (so cameras and frames get independent noise).
 uint64_t frame_seed(int64_t scene_seed, int64_t utime, const std::string& camera);
 
-/// `rgb` (CV_8UC3) seen through `sensor`: out = clamp(gain * in + black + noise).
+/// `rgb` (CV_8UC3) seen through `sensor`: out = clamp(round(gain * in + black + noise)); the noise
+/// is zero-mean with stddev noise_stddev (a sum of four uniforms, close to Gaussian).
 /// Deterministic for a given `seed`. Returns a new image; `rgb` is unchanged.
 cv::Mat apply_sensor_model(const cv::Mat& rgb, const SensorModel& sensor, uint64_t seed);
 
