@@ -1,0 +1,374 @@
+#include "services/planner/motion_planner.h"
+
+#include <chrono>
+#include <cmath>
+#include <memory>
+#include <random>
+#include <sstream>
+#include <stdexcept>
+
+#include <ompl/base/MotionValidator.h>
+#include <ompl/base/ProblemDefinition.h>
+#include <ompl/base/SpaceInformation.h>
+#include <ompl/base/StateSampler.h>
+#include <ompl/base/goals/GoalStates.h>
+#include <ompl/base/spaces/RealVectorStateSpace.h>
+#include <ompl/geometric/PathGeometric.h>
+#include <ompl/geometric/planners/rrt/BiTRRT.h>
+#include <ompl/geometric/planners/rrt/RRTConnect.h>
+#include <ompl/util/Console.h>
+
+#include "services/planner/cell_birrt.h"
+#include "services/planner/path_simplifier.h"
+
+namespace bookgrasp {
+namespace ob = ompl::base;
+namespace og = ompl::geometric;
+
+namespace {
+
+using StateCheck = std::function<bool(const Eigen::VectorXd&)>;
+
+void to_state(const Eigen::VectorXd& q, ob::State* s) {
+  auto* v = s->as<ob::RealVectorStateSpace::StateType>()->values;
+  for (Eigen::Index i = 0; i < q.size(); ++i) v[i] = q[i];
+}
+
+Eigen::VectorXd from_state(const ob::State* s, int n) {
+  const auto* v = s->as<ob::RealVectorStateSpace::StateType>()->values;
+  Eigen::VectorXd q(n);
+  for (int i = 0; i < n; ++i) q[i] = v[i];
+  return q;
+}
+
+// Interpolated check of a straight joint-space segment; `a` is not re-checked.
+bool segment_ok(const StateCheck& valid, const Eigen::VectorXd& a, const Eigen::VectorXd& b, double resolution,
+                double* last_valid_fraction = nullptr) {
+  const int steps = std::max(1, static_cast<int>(std::ceil((b - a).norm() / resolution)));
+  for (int i = 1; i <= steps; ++i) {
+    const double t = static_cast<double>(i) / steps;
+    if (!valid(a + t * (b - a))) {
+      if (last_valid_fraction) *last_valid_fraction = static_cast<double>(i - 1) / steps;
+      return false;
+    }
+  }
+  if (last_valid_fraction) *last_valid_fraction = 1.0;
+  return true;
+}
+
+/// OMPL motion validator on top of the same interpolated check the simplifier uses.
+class InterpolatingMotionValidator : public ob::MotionValidator {
+ public:
+  InterpolatingMotionValidator(const ob::SpaceInformationPtr& si, StateCheck check, double resolution, int n)
+      : ob::MotionValidator(si), check_(std::move(check)), resolution_(resolution), n_(n) {}
+  bool checkMotion(const ob::State* s1, const ob::State* s2) const override {
+    const bool ok = segment_ok(check_, from_state(s1, n_), from_state(s2, n_), resolution_);
+    if (ok) ++valid_;
+    else ++invalid_;
+    return ok;
+  }
+  bool checkMotion(const ob::State* s1, const ob::State* s2, std::pair<ob::State*, double>& last_valid) const override {
+    double f = 0;
+    const Eigen::VectorXd a = from_state(s1, n_), b = from_state(s2, n_);
+    const bool ok = segment_ok(check_, a, b, resolution_, &f);
+    if (!ok) {
+      if (last_valid.first) to_state(a + f * (b - a), last_valid.first);
+      last_valid.second = f;
+      ++invalid_;
+    } else {
+      ++valid_;
+    }
+    return ok;
+  }
+
+ private:
+  StateCheck check_;
+  double resolution_;
+  int n_;
+};
+
+/// Uniform sampler with its own seeded generator, so stock planners are repeatable per request.
+class SeededSampler : public ob::StateSampler {
+ public:
+  SeededSampler(const ob::StateSpace* space, uint64_t seed) : ob::StateSampler(space), gen_(seed) {
+    const auto& b = space->as<ob::RealVectorStateSpace>()->getBounds();
+    low_ = b.low;
+    high_ = b.high;
+  }
+  void sampleUniform(ob::State* s) override {
+    auto* v = s->as<ob::RealVectorStateSpace::StateType>()->values;
+    for (size_t i = 0; i < low_.size(); ++i) v[i] = std::uniform_real_distribution<double>(low_[i], high_[i])(gen_);
+  }
+  void sampleUniformNear(ob::State* s, const ob::State* near, double distance) override {
+    auto* v = s->as<ob::RealVectorStateSpace::StateType>()->values;
+    const auto* c = near->as<ob::RealVectorStateSpace::StateType>()->values;
+    for (size_t i = 0; i < low_.size(); ++i)
+      v[i] = std::uniform_real_distribution<double>(std::max(low_[i], c[i] - distance),
+                                                    std::min(high_[i], c[i] + distance))(gen_);
+  }
+  void sampleGaussian(ob::State* s, const ob::State* mean, double stddev) override {
+    auto* v = s->as<ob::RealVectorStateSpace::StateType>()->values;
+    const auto* c = mean->as<ob::RealVectorStateSpace::StateType>()->values;
+    for (size_t i = 0; i < low_.size(); ++i)
+      v[i] = std::clamp(std::normal_distribution<double>(c[i], stddev)(gen_), low_[i], high_[i]);
+  }
+
+ private:
+  std::mt19937_64 gen_;
+  std::vector<double> low_, high_;
+};
+
+double rotation_angle(const Eigen::Matrix3d& a, const Eigen::Matrix3d& b) {
+  return Eigen::AngleAxisd(a.transpose() * b).angle();
+}
+
+std::string fmt(double v) {
+  std::ostringstream s;
+  s << v;
+  return s.str();
+}
+
+}  // namespace
+
+const char* to_string(PlanFailure f) {
+  switch (f) {
+    case PlanFailure::kNone: return "none";
+    case PlanFailure::kInvalidRequest: return "invalid_request";
+    case PlanFailure::kStartInCollision: return "start_in_collision";
+    case PlanFailure::kGoalInCollision: return "goal_in_collision";
+    case PlanFailure::kNoIk: return "no_ik";
+    case PlanFailure::kTimeout: return "timeout";
+    case PlanFailure::kUnknownPlanner: return "unknown_planner";
+  }
+  return "?";
+}
+
+const std::vector<std::string>& MotionPlanner::planner_names() {
+  static const std::vector<std::string> names{"CellBiRRT", "RRTConnect", "BiTRRT"};
+  return names;
+}
+
+MotionPlanner::MotionPlanner(InverseKinematics ik, MotionPlannerParams params)
+    : ik_(std::move(ik)), params_(std::move(params)) {
+  const int n = ik_.kinematics().num_joints();
+  if (params_.max_velocity.size() != n || params_.max_acceleration.size() != n)
+    throw std::invalid_argument("planner velocity/acceleration limits need " + std::to_string(n) + " values");
+  bool known = false;
+  for (const auto& name : planner_names()) known = known || name == params_.default_planner;
+  if (!known) throw std::invalid_argument("unknown default planner '" + params_.default_planner + "'");
+  if (!(params_.collision_resolution_rad > 0) || !(params_.range_rad > 0) || !(params_.cell_size_m > 0))
+    throw std::invalid_argument("planner resolution, range and cell size must be positive");
+  ompl::msg::setLogLevel(ompl::msg::LOG_WARN);
+}
+
+bool segment_collision_free(const PlanningScene& scene, const Eigen::VectorXd& a, const Eigen::VectorXd& b,
+                            double resolution_rad, bool with_margins) {
+  if (scene.check(a, with_margins).collision) return false;
+  return segment_ok([&](const Eigen::VectorXd& q) { return !scene.check(q, with_margins).collision; }, a, b,
+                    resolution_rad);
+}
+
+PlanOutcome MotionPlanner::plan(const PlanningScene& scene, const PlanRequest& req) const {
+  const auto t_begin = std::chrono::steady_clock::now();
+  const auto elapsed = [&] {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t_begin).count();
+  };
+  const ArmKinematics& kin = ik_.kinematics();
+  const int n = kin.num_joints();
+  PlanOutcome out;
+  out.planner = req.planner.empty() ? params_.default_planner : req.planner;
+  const auto fail = [&](PlanFailure f, const std::string& message) {
+    out.success = false;
+    out.failure = f;
+    out.message = message;
+    out.planning_time_s = elapsed();
+    return out;
+  };
+
+  // ---- request checks ----
+  bool known = false;
+  for (const auto& name : planner_names()) known = known || name == out.planner;
+  if (!known) {
+    std::string all;
+    for (const auto& name : planner_names()) all += (all.empty() ? "" : ", ") + name;
+    return fail(PlanFailure::kUnknownPlanner, "unknown planner '" + out.planner + "' (known: " + all + ")");
+  }
+  if (req.start.size() != n || !req.start.allFinite())
+    return fail(PlanFailure::kInvalidRequest, "start needs " + std::to_string(n) + " finite joint values");
+  if (!kin.within_limits(req.start, 1e-6))
+    return fail(PlanFailure::kInvalidRequest, "start is outside the joint limits");
+  if (!(req.time_budget_s > 0) || !std::isfinite(req.time_budget_s))
+    return fail(PlanFailure::kInvalidRequest, "time budget must be a positive number of seconds");
+  if (!(req.position_tolerance_m >= 0) || !(req.orientation_tolerance_rad >= 0) ||
+      !std::isfinite(req.position_tolerance_m) || !std::isfinite(req.orientation_tolerance_rad))
+    return fail(PlanFailure::kInvalidRequest, "tolerances must be finite and >= 0");
+  if (req.keep_orientation && !(req.orientation_tolerance_rad > 0))
+    return fail(PlanFailure::kInvalidRequest, "keep_orientation needs orientation_tolerance_rad > 0");
+  if (!req.goal_is_pose) {
+    if (req.goal_joints.size() != n || !req.goal_joints.allFinite())
+      return fail(PlanFailure::kInvalidRequest, "joint goal needs " + std::to_string(n) + " finite values");
+    if (!kin.within_limits(req.goal_joints, 1e-6))
+      return fail(PlanFailure::kInvalidRequest, "joint goal is outside the joint limits");
+  } else if (!req.goal_pose.matrix().allFinite()) {
+    return fail(PlanFailure::kInvalidRequest, "goal pose is not finite");
+  }
+  const Eigen::VectorXd start = req.start.cwiseMax(kin.lower_limits()).cwiseMin(kin.upper_limits());
+
+  // ---- validity: collisions with margins, plus the kept orientation ----
+  const Eigen::Isometry3d start_tip = kin.tip_pose(start);
+  const Eigen::Matrix3d kept = start_tip.linear();
+  const double band = req.orientation_tolerance_rad;
+  const bool keep = req.keep_orientation;
+  const StateCheck valid = [&scene, &kin, keep, kept, band](const Eigen::VectorXd& q) {
+    if (keep && rotation_angle(kin.tip_pose(q).linear(), kept) > band) return false;
+    return scene.is_valid(q);
+  };
+  const CollisionReport start_report = scene.check(start);
+  if (start_report.collision)
+    return fail(PlanFailure::kStartInCollision, "start is in collision: " + start_report.describe() +
+                                                    " (closer than the margin; move out before planning)");
+
+  // ---- goals ----
+  std::vector<Eigen::VectorXd> goals;
+  if (!req.goal_is_pose) {
+    const CollisionReport r = scene.check(req.goal_joints);
+    if (r.collision) return fail(PlanFailure::kGoalInCollision, "goal is in collision: " + r.describe());
+    if (keep && rotation_angle(kin.tip_pose(req.goal_joints).linear(), kept) > band)
+      return fail(PlanFailure::kInvalidRequest, "keep_orientation: the goal's tool orientation differs from the start's by more than the tolerance");
+    goals.push_back(req.goal_joints);
+  } else {
+    if (keep && rotation_angle(req.goal_pose.linear(), kept) > band)
+      return fail(PlanFailure::kInvalidRequest, "keep_orientation: the goal pose orientation differs from the start's by " +
+                                                     fmt(rotation_angle(req.goal_pose.linear(), kept)) + " rad, more than the tolerance");
+    std::mt19937_64 rng(req.seed ^ 0x9e3779b97f4a7c15ULL);
+    std::uniform_real_distribution<double> unit(0.0, 1.0);
+    int ik_ok = 0;
+    std::string ik_reason, collision;
+    for (int attempt = 0; attempt < params_.goal_ik_attempts &&
+                          static_cast<int>(goals.size()) < params_.goal_ik_solutions; ++attempt) {
+      Eigen::VectorXd seed(n);
+      if (attempt == 0) seed = start;
+      else if (attempt == 1) seed = ik_.params().preferred_posture;
+      else
+        for (int k = 0; k < n; ++k)
+          seed[k] = kin.lower_limits()[k] + unit(rng) * (kin.upper_limits()[k] - kin.lower_limits()[k]);
+      const IkResult r = ik_.solve_once(req.goal_pose, seed, ik_.params().max_iterations);
+      if (!r.success) {
+        ik_reason = r.reason;
+        continue;
+      }
+      ++ik_ok;
+      const CollisionReport c = scene.check(r.q);
+      if (c.collision) {
+        if (collision.empty()) collision = c.describe();
+        continue;
+      }
+      bool distinct = true;
+      for (const auto& g : goals) distinct = distinct && (g - r.q).norm() > 0.1;
+      if (distinct) goals.push_back(r.q);
+    }
+    if (ik_ok == 0)
+      return fail(PlanFailure::kNoIk, "no IK solution for the goal pose after " +
+                                          std::to_string(params_.goal_ik_attempts) + " attempts (" + ik_reason + ")");
+    if (goals.empty())
+      return fail(PlanFailure::kGoalInCollision, "all " + std::to_string(ik_ok) +
+                                                     " IK solutions of the goal pose are in collision, e.g. " + collision);
+  }
+
+  // ---- OMPL problem ----
+  auto space = std::make_shared<ob::RealVectorStateSpace>(n);
+  ob::RealVectorBounds bounds(n);
+  for (int k = 0; k < n; ++k) {
+    bounds.setLow(k, kin.lower_limits()[k]);
+    bounds.setHigh(k, kin.upper_limits()[k]);
+  }
+  space->setBounds(bounds);
+  const uint64_t seed = req.seed;
+  space->setStateSamplerAllocator(
+      [seed](const ob::StateSpace* s) -> ob::StateSamplerPtr { return std::make_shared<SeededSampler>(s, seed); });
+  auto si = std::make_shared<ob::SpaceInformation>(space);
+  si->setStateValidityChecker([&valid, n](const ob::State* s) { return valid(from_state(s, n)); });
+  si->setMotionValidator(std::make_shared<InterpolatingMotionValidator>(si, valid, params_.collision_resolution_rad, n));
+  si->setup();
+  auto pdef = std::make_shared<ob::ProblemDefinition>(si);
+  {
+    ob::ScopedState<> s(space);
+    to_state(start, s.get());
+    pdef->addStartState(s);
+    auto goal_states = std::make_shared<ob::GoalStates>(si);
+    for (const auto& g : goals) {
+      to_state(g, s.get());
+      goal_states->addState(s);
+    }
+    pdef->setGoal(goal_states);
+  }
+  ob::PlannerPtr planner;
+  std::shared_ptr<CellBiRRT> cell;
+  if (out.planner == "CellBiRRT") {
+    CellBiRrtParams cp;
+    cp.range_rad = params_.range_rad;
+    cp.cell_size_m = params_.cell_size_m;
+    cp.workspace_min = params_.workspace_min;
+    cp.workspace_max = params_.workspace_max;
+    cp.tube_sigma_m = params_.tube_sigma_m;
+    cp.min_cell_weight = params_.min_cell_weight;
+    cp.failure_decay = params_.failure_decay;
+    cp.cell_sample_probability = params_.cell_sample_probability;
+    cp.orientation_noise_rad = params_.orientation_noise_rad;
+    cp.ik_iterations = params_.cell_ik_iterations;
+    CellBiRrtProblem problem;
+    problem.start_tip = start_tip;
+    problem.goal_tip = req.goal_is_pose ? req.goal_pose : kin.tip_pose(goals.front());
+    problem.keep_orientation = keep;
+    problem.constrained_orientation = kept;
+    problem.seed = seed;
+    const auto& env = scene.environment();
+    problem.point_free = [&env](const Eigen::Vector3d& p) {
+      for (const SceneBox& b : env) {
+        const Eigen::Vector3d local = b.pose.inverse() * p;
+        if ((local.cwiseAbs() - 0.5 * b.size).maxCoeff() < 0) return false;
+      }
+      return true;
+    };
+    cell = std::make_shared<CellBiRRT>(si, ik_, cp, problem);
+    planner = cell;
+  } else if (out.planner == "RRTConnect") {
+    auto p = std::make_shared<og::RRTConnect>(si);
+    p->setRange(params_.range_rad);
+    planner = p;
+  } else {
+    auto p = std::make_shared<og::BiTRRT>(si);
+    p->setRange(params_.range_rad);
+    planner = p;
+  }
+  planner->setProblemDefinition(pdef);
+  planner->setup();
+  const ob::PlannerStatus status = planner->solve(ob::timedPlannerTerminationCondition(req.time_budget_s));
+  if (status != ob::PlannerStatus::EXACT_SOLUTION || !pdef->hasExactSolution()) {
+    return fail(PlanFailure::kTimeout, out.planner + " found no path within the time budget of " +
+                                           fmt(req.time_budget_s) + " s (status: " + status.asString() + ")");
+  }
+  const auto* path = pdef->getSolutionPath()->as<og::PathGeometric>();
+  for (size_t i = 0; i < path->getStateCount(); ++i) out.raw_path.push_back(from_state(path->getState(i), n));
+
+  // ---- simplify and time-parameterise ----
+  const MotionCheck motion = [&](const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
+    return segment_ok(valid, a, b, params_.collision_resolution_rad);
+  };
+  out.path = simplify_path(out.raw_path, motion, params_.simplify_shortcuts, seed);
+  out.trajectory = parameterize_trapezoidal(out.path, params_.max_velocity, params_.max_acceleration,
+                                            params_.sample_period_s);
+  out.path_length_rad = path_length(out.path);
+  out.success = true;
+  out.failure = PlanFailure::kNone;
+  std::ostringstream msg;
+  msg << out.planner << ": " << out.path.size() << " waypoints (" << out.raw_path.size() << " before simplification), "
+      << fmt(out.path_length_rad) << " rad, " << fmt(out.trajectory.duration_s) << " s";
+  if (cell) msg << ", " << cell->tree_size() << " nodes, cell samples " << cell->cell_samples_ok() << "/"
+                << cell->cell_samples_tried();
+  out.message = msg.str();
+  out.planning_time_s = elapsed();
+  return out;
+}
+
+}  // namespace bookgrasp

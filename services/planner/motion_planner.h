@@ -1,0 +1,114 @@
+#pragma once
+/// @file
+/// The motion planner core (no LCM, no OMPL in this header): a start
+/// configuration and a goal (joint values or a tool pose with tolerances) in
+/// a PlanningScene -> a collision-free, simplified, time-parameterised joint
+/// trajectory, or a failure with its reason. Planners: CellBiRRT (the
+/// paper's), and OMPL's RRTConnect and BiTRRT for comparison.
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+#include "common/kinematics/inverse_kinematics.h"
+#include "services/planner/planning_scene.h"
+#include "services/planner/time_parameterization.h"
+
+namespace bookgrasp {
+
+/// Why a plan failed (values equal plan_result_t's constants).
+enum class PlanFailure {
+  kNone = 0,
+  kInvalidRequest = 1,
+  kStartInCollision = 2,
+  kGoalInCollision = 3,
+  kNoIk = 4,
+  kTimeout = 5,
+  kUnknownPlanner = 6,
+};
+
+/// Short name of a failure ("timeout", "no_ik", ...).
+const char* to_string(PlanFailure failure);
+
+/// One planning query.
+struct PlanRequest {
+  Eigen::VectorXd start;                  ///< start joints (rad)
+  bool goal_is_pose = false;              ///< false: goal_joints; true: goal_pose
+  Eigen::VectorXd goal_joints;            ///< joint goal (rad)
+  Eigen::Isometry3d goal_pose = Eigen::Isometry3d::Identity();  ///< tool (gripper) pose in base
+  double position_tolerance_m = 0.001;    ///< pose goal: accepted position error
+  double orientation_tolerance_rad = 0.01;///< pose goal error; also the band of keep_orientation
+  bool keep_orientation = false;          ///< keep the tool orientation of the start along the path
+  double time_budget_s = 1.0;             ///< planning time limit (wall clock)
+  std::string planner;                    ///< "CellBiRRT", "RRTConnect", "BiTRRT"; "" = default
+  uint64_t seed = 1;                      ///< random seed (same request + seed -> same path)
+};
+
+/// The answer.
+struct PlanOutcome {
+  bool success = false;
+  PlanFailure failure = PlanFailure::kNone;
+  std::string message;                 ///< what happened, for people
+  std::string planner;                 ///< planner that ran
+  std::vector<Eigen::VectorXd> path;   ///< simplified waypoints (start first)
+  std::vector<Eigen::VectorXd> raw_path;  ///< waypoints as the planner found them
+  TimedTrajectory trajectory;          ///< time-parameterised path
+  double planning_time_s = 0.0;        ///< search + simplification, wall clock
+  double path_length_rad = 0.0;        ///< joint-space length of `path`
+};
+
+/// Settings of the planner (configuration `planner`; see docs/PLANNER.md).
+struct MotionPlannerParams {
+  std::string default_planner = "CellBiRRT";
+  double collision_resolution_rad = 0.01;  ///< motion checks every this many rad (joint-space norm)
+  double range_rad = 0.3;                  ///< tree extension step of all planners
+  int simplify_shortcuts = 60;             ///< random shortcut attempts
+  int goal_ik_solutions = 4;               ///< distinct valid IK solutions used as goals for a pose goal
+  int goal_ik_attempts = 24;               ///< IK attempts to find them
+  Eigen::VectorXd max_velocity;            ///< rad/s per joint (trajectory)
+  Eigen::VectorXd max_acceleration;        ///< rad/s^2 per joint (trajectory)
+  double sample_period_s = 0.02;           ///< trajectory sample period
+  // CellBiRRT
+  double cell_size_m = 0.1;
+  Eigen::Vector3d workspace_min{-1.2, -1.2, -0.9};
+  Eigen::Vector3d workspace_max{1.2, 1.2, 1.4};
+  double tube_sigma_m = 0.25;
+  double min_cell_weight = 0.02;
+  double failure_decay = 0.7;
+  double cell_sample_probability = 0.8;
+  double orientation_noise_rad = 0.5;
+  int cell_ik_iterations = 40;
+};
+
+/// The planner. Immutable; plan() is const and may run concurrently on different scenes.
+class MotionPlanner {
+ public:
+  /// Throws std::invalid_argument for inconsistent parameters (limit sizes, unknown default planner).
+  MotionPlanner(InverseKinematics ik, MotionPlannerParams params);
+
+  /// Plans in `scene` (which holds the environment and any attached book).
+  /// Never throws for a bad request: it is answered with kInvalidRequest.
+  PlanOutcome plan(const PlanningScene& scene, const PlanRequest& request) const;
+
+  /// Planner names accepted in PlanRequest::planner.
+  static const std::vector<std::string>& planner_names();
+  /// The IK solver.
+  const InverseKinematics& ik() const { return ik_; }
+  /// The parameters.
+  const MotionPlannerParams& params() const { return params_; }
+
+ private:
+  InverseKinematics ik_;
+  MotionPlannerParams params_;
+};
+
+/// True if every configuration on the straight segment a -> b, at spacing
+/// `resolution_rad` (joint-space norm, both ends included), passes `scene.check`
+/// (with or without margins). Used by the planner and by tests at finer resolution.
+bool segment_collision_free(const PlanningScene& scene, const Eigen::VectorXd& a, const Eigen::VectorXd& b,
+                            double resolution_rad, bool with_margins);
+
+}  // namespace bookgrasp
