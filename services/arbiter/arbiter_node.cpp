@@ -1,0 +1,402 @@
+#include "services/arbiter/arbiter_node.h"
+
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <stdexcept>
+
+#include "common/grasp_frame.h"
+#include "common/pose_conversion.h"
+
+namespace bookgrasp {
+namespace {
+
+constexpr double kNan = std::numeric_limits<double>::quiet_NaN();
+
+std::string mm(double metres) {
+  char buf[32];
+  std::snprintf(buf, sizeof(buf), "%.1f mm", metres * 1000.0);
+  return buf;
+}
+
+std::string mm3(const Eigen::Vector3d& p) {
+  char buf[96];
+  std::snprintf(buf, sizeof(buf), "(%.1f, %.1f, %.1f) mm", p.x() * 1000, p.y() * 1000, p.z() * 1000);
+  return buf;
+}
+
+void put(double (&dst)[3], const Eigen::Vector3d& v) {
+  for (int i = 0; i < 3; ++i) dst[i] = v[i];
+}
+
+void put_nan(double (&dst)[3]) {
+  for (double& d : dst) d = kNan;
+}
+
+validation_step_t to_msg(const ValidationStep& s, int64_t utime) {
+  validation_step_t m;
+  m.utime = utime;
+  m.rule = s.rule;
+  m.value_m = s.value;
+  m.tolerance_m = s.tolerance;
+  m.passed = s.passed;
+  m.decision = s.decision;
+  return m;
+}
+
+bool finite3(const double (&v)[3]) { return std::isfinite(v[0]) && std::isfinite(v[1]) && std::isfinite(v[2]); }
+
+}  // namespace
+
+ArbiterSettings ArbiterSettings::from_config(const Config& root) {
+  ArbiterSettings s;
+  const Config ch = root.child("channels");
+  s.channels.book_corner_stereo = ch.get<std::string>("book_corner_stereo");
+  s.channels.servo_status = ch.get<std::string>("servo_status");
+  s.channels.servo_request = ch.get<std::string>("servo_request");
+  s.channels.markers = ch.get<std::string>("markers");
+  s.channels.arm_state = ch.get<std::string>("arm_state");
+  s.channels.detector_switch = ch.get<std::string>("detector_switch");
+  s.channels.grasp_point = ch.get<std::string>("grasp_point");
+  s.follow_logical_channel = root.get<std::string>("follow.logical_channel");
+  s.follow_implementation = root.get<std::string>("follow.implementation");
+  if (s.follow_implementation.empty())
+    throw ConfigError(root.source() + ": " + root.path_of("follow.implementation") +
+                      " is empty: name the BOOK_CORNER_STEREO implementation to follow (e.g. god)");
+  s.tolerances.p1_ps_y = root.get_double("tolerances.p1_ps_y_m", 0.0001, 0.2);
+  s.tolerances.y = root.get_double("tolerances.y_m", 0.0001, 0.2);
+  s.tolerances.x = root.get_double("tolerances.x_m", 0.0001, 0.2);
+  s.tolerances.max_rank = root.get_int("tolerances.max_rank", 1, 50);
+  s.size_limits.l_max = root.get_double("gripper.l_max_m", 0.005, 0.5);
+  s.cart_marker_role = root.get<std::string>("cart.marker_role");
+  const std::vector<double> o = root.get_vector("cart.grasp_origin_in_marker_m", 3);
+  s.grasp_origin_in_marker = Eigen::Vector3d(o[0], o[1], o[2]);
+  if (!s.grasp_origin_in_marker.allFinite() || s.grasp_origin_in_marker.norm() > 5.0)
+    throw ConfigError(root.source() + ": " + root.path_of("cart.grasp_origin_in_marker_m") +
+                      " must be finite and within 5 m of the marker");
+  s.book_front_z = root.get_double("cart.book_front_z_m", -1.0, 1.0);
+  s.align_with_book_slope = root.get<bool>("gp.align_with_book_slope");
+  s.max_slope_rad = root.get_double("gp.max_slope_deg", 0.0, 45.0) * M_PI / 180.0;
+  s.width_settle_s = root.get_double("book_width.settle_s", 0.0, 10.0);
+  s.width_settle_tolerance = root.get_double("book_width.settle_tolerance_m", 0.00001, 0.01);
+  return s;
+}
+
+ArbiterNode::ArbiterNode(const Config& root)
+    : ArbiterNode(root.get<std::string>("service.name"), root.get<std::string>("service.implementation"),
+                  ArbiterSettings::from_config(root)) {}
+
+ArbiterNode::ArbiterNode(const std::string& service, const std::string& implementation, ArbiterSettings settings)
+    : Component(service, implementation), s_(std::move(settings)), follow_(s_.follow_implementation) {
+  subscribe(s_.channels.book_corner_stereo, &ArbiterNode::on_book_corner);
+  subscribe(s_.channels.servo_status, &ArbiterNode::on_servo_status);
+  subscribe(s_.channels.servo_request, &ArbiterNode::on_servo_request);
+  subscribe(s_.channels.markers, &ArbiterNode::on_markers);
+  subscribe(s_.channels.arm_state, &ArbiterNode::on_arm_state);
+  subscribe(s_.channels.detector_switch, &ArbiterNode::on_switch);
+}
+
+Eigen::Vector3d ArbiterNode::to_grasp(const Eigen::Vector3d& p_base) const { return frame_->inverse() * p_base; }
+Eigen::Vector3d ArbiterNode::to_base(const Eigen::Vector3d& p_grasp) const { return *frame_ * p_grasp; }
+
+void ArbiterNode::open_attempt() {
+  frozen_ = false;
+  frozen_p1_.reset();
+}
+
+void ArbiterNode::on_markers(const marker_detections_t& msg) {
+  for (const marker_t& m : msg.markers) {
+    if (m.role != s_.cart_marker_role) continue;
+    if (!is_valid_pose(m.pose_in_base)) {
+      reject(s_.channels.markers, "cart marker " + std::to_string(m.id) + " has an invalid pose_in_base (NaN or not a unit quaternion)");
+      return;
+    }
+    const Eigen::Isometry3d t = pose_to_isometry(m.pose_in_base);
+    // AprilTag frame: z points into the tag, i.e. into the cart's rear board.
+    Eigen::Isometry3d g;
+    try {
+      g = grasp_frame_in_base(t.linear().col(2), Eigen::Vector3d::Zero());
+    } catch (const std::invalid_argument& e) {
+      reject(s_.channels.markers, std::string("cart marker is not upright (its normal is vertical): ") + e.what());
+      return;
+    }
+    g.translation() = t.translation() + g.linear() * s_.grasp_origin_in_marker;
+    frame_ = g;
+    return;
+  }
+}
+
+void ArbiterNode::on_switch(const detector_switch_t& msg) {
+  if (msg.logical_channel != s_.follow_logical_channel) return;
+  if (msg.implementation.empty()) {
+    reject(s_.channels.detector_switch, "switch for " + msg.logical_channel + " names no implementation");
+    return;
+  }
+  const std::string before = follow_;
+  follow_ = msg.implementation;
+  switch_note_ = "switched from '" + before + "' at utime " + std::to_string(msg.utime) +
+                 (msg.reason.empty() ? "" : " (" + msg.reason + ")");
+  // A P1 of the previous implementation is not used for a new attempt.
+  if (!frozen_) {
+    latest_p1_.reset();
+    have_p1_msg_ = false;
+  }
+  // Visible in SERVICE_STATUS.last_error (the runtime has no other free-text field).
+  report_error("detector switch: now following " + s_.follow_logical_channel + " implementation '" + follow_ +
+               "', " + switch_note_);
+}
+
+void ArbiterNode::on_book_corner(const book_corner_stereo_t& msg) {
+  if (msg.implementation != follow_) return;  // another implementation: not followed now
+  if (msg.found && !finite3(msg.p1_base)) {
+    reject(s_.channels.book_corner_stereo, "found = true but p1_base is not finite");
+    return;
+  }
+  have_p1_msg_ = true;
+  if (msg.found)
+    latest_p1_ = Eigen::Vector3d(msg.p1_base[0], msg.p1_base[1], msg.p1_base[2]);
+  else
+    latest_p1_.reset();
+  if (!frozen_) publish_p1_check(msg.utime, 0);
+}
+
+void ArbiterNode::on_servo_request(const servo_request_t& msg) {
+  if (msg.mode != servo_request_t::CANCEL && msg.mode != servo_request_t::BOOK_CORNER &&
+      msg.mode != servo_request_t::STRIPE_END) {
+    reject(s_.channels.servo_request, "unknown servo mode " + std::to_string(static_cast<int>(msg.mode)));
+    return;
+  }
+  if (msg.mode == servo_request_t::CANCEL) {
+    open_attempt();
+    return;
+  }
+  if (msg.mode == servo_request_t::BOOK_CORNER && msg.rank_from_right < 0) {
+    reject(s_.channels.servo_request, "rank_from_right " + std::to_string(msg.rank_from_right) + " is negative");
+    return;
+  }
+  if (!frozen_) {
+    frozen_ = true;
+    frozen_p1_ = latest_p1_;
+  }
+  if (msg.mode == servo_request_t::BOOK_CORNER) {
+    rank_of_request_[msg.request_id] = msg.rank_from_right;
+    while (rank_of_request_.size() > 64) rank_of_request_.erase(rank_of_request_.begin());
+  }
+}
+
+void ArbiterNode::on_servo_status(const servo_status_t& msg) {
+  if (msg.mode != servo_request_t::BOOK_CORNER && msg.mode != servo_request_t::STRIPE_END) return;
+  const bool converged = msg.state == servo_status_t::CONVERGED;
+  const bool failed = msg.state == servo_status_t::FEATURE_LOST || msg.state == servo_status_t::TIMEOUT ||
+                      msg.state == servo_status_t::FAILED;
+  if (!converged && !failed) return;
+  if (converged && !is_valid_pose(msg.converged_pose)) {
+    reject(s_.channels.servo_status, "CONVERGED status of request " + std::to_string(msg.request_id) +
+                                         " has an invalid converged_pose (NaN or not a unit quaternion)");
+    return;
+  }
+  if (msg.request_id == last_decided_request_) return;  // repeated status of a request already answered
+  if (msg.mode == servo_request_t::STRIPE_END) {
+    if (!converged) return;  // the coordinator handles a failed stripe servo
+    last_decided_request_ = msg.request_id;
+    const pose_t& p = msg.converged_pose;
+    ps_ = Eigen::Vector3d(p.position[0], p.position[1], p.position[2]);
+    publish_p1_check(msg.utime, msg.request_id);
+    return;
+  }
+  decide(msg);
+}
+
+grasp_point_t ArbiterNode::base_message(int64_t utime, int64_t request_id) const {
+  grasp_point_t m;
+  m.utime = utime;
+  m.request_id = request_id;
+  m.valid = false;
+  put_nan(m.gp_grasp);
+  put_nan(m.p1_grasp);
+  put_nan(m.p2_grasp);
+  put_nan(m.ps_grasp);
+  m.gp_base = isometry_to_pose(Eigen::Isometry3d::Identity(), "base", "gripper", utime);
+  m.slope_rad = 0;
+  m.p1_used = false;
+  m.p2_used = false;
+  m.num_steps = 0;
+  return m;
+}
+
+namespace {
+void finish(grasp_point_t* m, const std::string& follow, const std::string& switch_note) {
+  validation_step_t src;
+  src.utime = m->utime;
+  src.rule = "P1 source";
+  src.value_m = 0;
+  src.tolerance_m = 0;
+  src.passed = true;
+  src.decision = "BOOK_CORNER_STEREO implementation '" + follow + "'" + (switch_note.empty() ? "" : ", " + switch_note);
+  m->steps.insert(m->steps.begin(), src);
+  m->num_steps = static_cast<int32_t>(m->steps.size());
+  m->reason += " [P1 from '" + follow + "']";
+}
+}  // namespace
+
+void ArbiterNode::publish_p1_check(int64_t utime, int64_t request_id) {
+  if (!frame_) {
+    report_error("P1 check skipped: no cart marker seen yet, the grasp frame is unknown");
+    return;
+  }
+  grasp_point_t m = base_message(utime, request_id);
+  const std::optional<Eigen::Vector3d>& p1b = frozen_ ? frozen_p1_ : latest_p1_;
+  std::optional<Eigen::Vector3d> p1;
+  if (p1b) p1 = to_grasp(*p1b);
+  if (p1) put(m.p1_grasp, *p1);
+  if (!ps_) {
+    m.reason = "NEED_PS: no PS known (first run or arbiter restarted): run BSwH to the stripe end";
+    m.steps.push_back(to_msg({"PS", kNan, kNan, false, "no PS to validate P1 against"}, utime));
+    finish(&m, follow_, switch_note_);
+    publish(s_.channels.grasp_point, m);
+    return;
+  }
+  CombinationInputs in;
+  in.p1 = p1;
+  in.ps = to_grasp(*ps_);
+  put(m.ps_grasp, in.ps);
+  const CombinationResult r = validate_p1(in, s_.tolerances);
+  for (const ValidationStep& st : r.steps) m.steps.push_back(to_msg(st, utime));
+  m.p1_used = r.p1_valid;
+  put(m.gp_grasp, r.bwh_start);
+  Eigen::Isometry3d start = *frame_;
+  start.translation() = to_base(r.bwh_start);
+  m.gp_base = isometry_to_pose(start, "base", "gripper", utime);
+  m.reason = std::string(r.p1_valid ? "P1_VALID: " : "P1_INVALID: ") +
+             (r.steps.empty() ? std::string("") : r.steps.back().decision);
+  finish(&m, follow_, switch_note_);
+  publish(s_.channels.grasp_point, m);
+}
+
+void ArbiterNode::decide(const servo_status_t& msg) {
+  last_decided_request_ = msg.request_id;
+  grasp_point_t m = base_message(msg.utime, msg.request_id);
+  const bool converged = msg.state == servo_status_t::CONVERGED;
+  if (!frame_ || !ps_) {
+    m.reason = !frame_ ? "NO_GRASP: no cart marker seen: the grasp frame is unknown"
+                       : "NO_GRASP: no PS known: run BSwH to the stripe end first";
+    m.steps.push_back(to_msg({"inputs", kNan, kNan, false, m.reason.substr(10)}, msg.utime));
+    finish(&m, follow_, switch_note_);
+    publish(s_.channels.grasp_point, m);
+    open_attempt();
+    return;
+  }
+  const std::optional<Eigen::Vector3d>& p1b = frozen_ ? frozen_p1_ : latest_p1_;
+  CombinationInputs in;
+  if (p1b) in.p1 = to_grasp(*p1b);
+  in.ps = to_grasp(*ps_);
+  const auto rank_it = rank_of_request_.find(msg.request_id);
+  in.p2_rank = rank_it == rank_of_request_.end() ? 0 : rank_it->second;
+  in.front_z_fallback = s_.book_front_z;
+  double slope = 0;
+  if (converged) {
+    const Eigen::Isometry3d p2 = pose_to_isometry(msg.converged_pose);
+    in.p2 = to_grasp(p2.translation());
+    put(m.p2_grasp, *in.p2);
+    const Eigen::Vector3d xg = frame_->linear().transpose() * p2.linear().col(0);
+    slope = std::atan2(xg.y(), xg.x());
+  }
+  if (in.p1) put(m.p1_grasp, *in.p1);
+  put(m.ps_grasp, in.ps);
+  m.slope_rad = slope;
+
+  CombinationResult r = combine(in, s_.tolerances);
+  if (!converged && !r.steps.empty())
+    r.steps.back().decision += " (servo state " + std::to_string(static_cast<int>(msg.state)) +
+                               (msg.message.empty() ? "" : ": " + msg.message) + ")";
+  m.p1_used = r.p1_valid;
+  const std::string last = r.steps.empty() ? std::string("") : r.steps.back().decision;
+  switch (r.outcome) {
+    case GraspOutcome::kGrasp: {
+      Eigen::Matrix3d rot = frame_->linear();
+      const bool use_slope = s_.align_with_book_slope && std::abs(slope) <= s_.max_slope_rad;
+      if (use_slope) rot = rot * Eigen::AngleAxisd(slope, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+      r.steps.push_back({"GP slope", slope, s_.max_slope_rad, use_slope || !s_.align_with_book_slope,
+                         !s_.align_with_book_slope ? "GP keeps the grasp-frame orientation (alignment off)"
+                         : use_slope ? "gripper aligned with the book slope from BwH"
+                                     : "servo slope beyond gp.max_slope_deg: not trusted, grasp-frame orientation kept"});
+      Eigen::Isometry3d gp = Eigen::Isometry3d::Identity();
+      gp.linear() = rot;
+      gp.translation() = to_base(r.gp);
+      m.gp_base = isometry_to_pose(gp, "base", "gripper", msg.utime);
+      put(m.gp_grasp, r.gp);
+      m.valid = true;
+      m.p2_used = true;
+      m.reason = "GRASP: GP = " + mm3(r.gp) + " in the grasp frame (" + (r.p1_valid ? "P1 valid" : "P1 not used") + ")";
+      width_pending_ = true;
+      width_request_ = msg.request_id;
+      last_gp_grasp_ = r.gp;
+      last_ps_grasp_ = in.ps;
+      last_frame_ = *frame_;
+      settle_start_utime_ = -1;
+      open_attempt();
+      break;
+    }
+    case GraspOutcome::kNextRegion:
+      m.reason = "NEXT_REGION rank " + std::to_string(r.next_rank) + ": " + last;
+      break;
+    case GraspOutcome::kNoGrasp:
+      m.reason = "NO_GRASP: " + last;
+      open_attempt();
+      break;
+  }
+  for (const ValidationStep& st : r.steps) m.steps.push_back(to_msg(st, msg.utime));
+  finish(&m, follow_, switch_note_);
+  publish(s_.channels.grasp_point, m);
+}
+
+void ArbiterNode::on_arm_state(const arm_state_t& msg) {
+  if (!std::isfinite(msg.gripper_width_m)) {
+    reject(s_.channels.arm_state, "gripper_width_m is not finite");
+    return;
+  }
+  if (!width_pending_) return;
+  if (!msg.gripper_contact || msg.gripper_width_m <= 0) {
+    settle_start_utime_ = -1;
+    return;
+  }
+  const double w = msg.gripper_width_m;
+  if (settle_start_utime_ < 0 || std::abs(w - settle_start_width_) > s_.width_settle_tolerance ||
+      msg.utime < settle_start_utime_) {
+    settle_start_utime_ = msg.utime;
+    settle_start_width_ = w;
+    if (s_.width_settle_s > 0) return;
+  }
+  if (static_cast<double>(msg.utime - settle_start_utime_) < s_.width_settle_s * 1e6) return;
+
+  width_pending_ = false;
+  const double bw = w;
+  grasp_point_t m = base_message(msg.utime, width_request_);
+  const ValidationStep check = check_book_width(bw, s_.size_limits);
+  m.steps.push_back(to_msg(check, msg.utime));
+  put(m.gp_grasp, last_gp_grasp_);
+  Eigen::Isometry3d gp = last_frame_;
+  gp.translation() = last_frame_ * last_gp_grasp_;
+  m.gp_base = isometry_to_pose(gp, "base", "gripper", msg.utime);
+  const bool usable = bw <= s_.size_limits.l_max;
+  if (usable) {
+    const Eigen::Vector3d next = next_ps(last_ps_grasp_, last_gp_grasp_, bw);
+    ps_ = last_frame_ * next;
+    put(m.ps_grasp, next);
+    m.steps.push_back(to_msg({"PS.y = GP.y - BW", next.y(), 0.0, true,
+                              "next PS.y = " + mm(last_gp_grasp_.y()) + " - " + mm(bw) + " = " + mm(next.y())},
+                             msg.utime));
+  } else {
+    ps_.reset();
+    m.steps.push_back(to_msg({"PS.y = GP.y - BW", kNan, 0.0, false,
+                              "plate distance beyond L_max: PS dropped, run BSwH again for the next book"},
+                             msg.utime));
+  }
+  m.valid = check.passed;
+  m.p2_used = true;
+  m.reason = "BOOK_WIDTH: BW = " + mm(bw) + " from the gripper plates; " + check.decision;
+  finish(&m, follow_, switch_note_);
+  publish(s_.channels.grasp_point, m);
+}
+
+}  // namespace bookgrasp

@@ -1,0 +1,120 @@
+#pragma once
+/// @file
+/// The arbiter process (paper Section 3): fuses P1 (BwS), PS (BSwH or the
+/// previous grasp) and P2 (BwH servoing) with the combination strategy in the
+/// `grasp` frame and publishes every decision on GRASP_POINT.
+///
+/// Protocol (no request message; decisions follow the bus, see docs/ARCHITECTURE.md):
+/// - The grasp frame is the cart frame seen from the robot: origin at the upper
+///   shelf's front edge centre, placed from the cart marker (MARKERS, role
+///   `cart.marker_role`) by `cart.grasp_origin_in_marker_m`; Z = the marker's
+///   into-board axis made horizontal, X = base up, Y = right.
+/// - P1 comes from BOOK_CORNER_STEREO messages of the followed implementation
+///   (`follow.implementation`, changed by DETECTOR_SWITCH). An *attempt* (one
+///   try at one book) opens at start and after every GRASP or NO_GRASP decision
+///   and every SERVO_REQUEST CANCEL; its P1 is frozen at the attempt's first
+///   non-cancel SERVO_REQUEST (the latest P1 before it, taken while the arm was
+///   out of the stereo view).
+/// - GRASP_POINT.reason starts with the outcome word:
+///   `P1_VALID` / `P1_INVALID` (P1 check: on every followed BOOK_CORNER_STEREO
+///   while P1 is not frozen and PS is known, and when a STRIPE_END servo
+///   converges; gp_grasp = where BwH starts (P1 or PS), gp_base = that point
+///   with the grasp orientation; valid = false, p1_used = P1 valid),
+///   `NEED_PS` (a P1 arrived but no PS is known: run BSwH),
+///   `GRASP` (a BOOK_CORNER servo converged and GP is valid: valid = true),
+///   `NEXT_REGION rank N` (re-run BwH on region N from the right),
+///   `NO_GRASP` (no grasp point: the BwH servo failed, no region left, no frame),
+///   `BOOK_WIDTH` (after a GRASP: the gripper closed on the book; BW measured
+///   from the plates, PS updated to PS.y = GP.y - BW; valid = width admissible).
+
+#include <cstdint>
+#include <map>
+#include <optional>
+#include <string>
+
+#include <Eigen/Geometry>
+
+#include "bookgrasp/arm_state_t.hpp"
+#include "bookgrasp/book_corner_stereo_t.hpp"
+#include "bookgrasp/detector_switch_t.hpp"
+#include "bookgrasp/grasp_point_t.hpp"
+#include "bookgrasp/marker_detections_t.hpp"
+#include "bookgrasp/servo_request_t.hpp"
+#include "bookgrasp/servo_status_t.hpp"
+#include "common/component.h"
+#include "common/config.h"
+#include "services/arbiter/combination_strategy.h"
+
+namespace bookgrasp {
+
+/// Everything the arbiter node reads from its configuration.
+struct ArbiterSettings {
+  /// Channel names.
+  struct Channels {
+    std::string book_corner_stereo, servo_status, servo_request, markers, arm_state, detector_switch, grasp_point;
+  } channels;
+  std::string follow_logical_channel;   ///< DETECTOR_SWITCH.logical_channel this node answers to
+  std::string follow_implementation;    ///< initial implementation of BOOK_CORNER_STEREO to follow
+  CombinationTolerances tolerances;     ///< the paper's tolerances
+  BookSizeLimits size_limits;           ///< L_max of the gripper
+  std::string cart_marker_role;         ///< MARKERS role of the cart marker
+  /// Cart (grasp-frame) origin from the marker centre, in grasp axes (X up, Y right, Z into the shelf), m.
+  Eigen::Vector3d grasp_origin_in_marker = Eigen::Vector3d::Zero();
+  double book_front_z = 0;              ///< book-front plane Z in the grasp frame (GP.z without a valid P1)
+  bool align_with_book_slope = true;    ///< rotate GP's orientation about Z by the servo's slope
+  double max_slope_rad = 0.2;           ///< larger servo slopes are not trusted (GP keeps the grasp orientation)
+  double width_settle_s = 0.2;          ///< the plate distance must hold this long (message time) ...
+  double width_settle_tolerance = 0.0005;  ///< ... within this, with contact, to count as the book width
+
+  /// Reads and validates every key; throws ConfigError naming a bad one.
+  static ArbiterSettings from_config(const Config& root);
+};
+
+/// The arbiter component.
+class ArbiterNode : public Component {
+ public:
+  /// Reads its settings from `root` (see ArbiterSettings::from_config).
+  explicit ArbiterNode(const Config& root);
+  /// Same with settings already read (tests).
+  ArbiterNode(const std::string& service, const std::string& implementation, ArbiterSettings settings);
+
+  /// The implementation of BOOK_CORNER_STEREO followed now.
+  const std::string& followed_implementation() const { return follow_; }
+
+ private:
+  void on_book_corner(const book_corner_stereo_t& msg);
+  void on_servo_status(const servo_status_t& msg);
+  void on_servo_request(const servo_request_t& msg);
+  void on_markers(const marker_detections_t& msg);
+  void on_arm_state(const arm_state_t& msg);
+  void on_switch(const detector_switch_t& msg);
+
+  void open_attempt();
+  void publish_p1_check(int64_t utime, int64_t request_id);
+  void decide(const servo_status_t& msg);
+  grasp_point_t base_message(int64_t utime, int64_t request_id) const;
+  Eigen::Vector3d to_grasp(const Eigen::Vector3d& p_base) const;
+  Eigen::Vector3d to_base(const Eigen::Vector3d& p_grasp) const;
+
+  ArbiterSettings s_;
+  std::string follow_;
+  std::string switch_note_;                    ///< last switch, for GRASP_POINT.reason
+  std::optional<Eigen::Isometry3d> frame_;     ///< grasp frame in base (from the cart marker)
+  std::optional<Eigen::Vector3d> latest_p1_;   ///< base; empty when BwS found nothing
+  bool have_p1_msg_ = false;                   ///< a followed BOOK_CORNER_STEREO arrived
+  std::optional<Eigen::Vector3d> frozen_p1_;   ///< P1 of the attempt (base)
+  bool frozen_ = false;
+  std::optional<Eigen::Vector3d> ps_;          ///< base
+  std::map<int64_t, int> rank_of_request_;     ///< BOOK_CORNER request id -> rank
+  int64_t last_decided_request_ = -1;
+  // After a GRASP: book-width measurement.
+  bool width_pending_ = false;
+  int64_t width_request_ = 0;
+  Eigen::Vector3d last_gp_grasp_ = Eigen::Vector3d::Zero();
+  Eigen::Vector3d last_ps_grasp_ = Eigen::Vector3d::Zero();
+  Eigen::Isometry3d last_frame_ = Eigen::Isometry3d::Identity();
+  int64_t settle_start_utime_ = -1;
+  double settle_start_width_ = 0;
+};
+
+}  // namespace bookgrasp

@@ -1,0 +1,419 @@
+// The arbiter node composed on memq:// with hand-made messages. Every expected number is worked out by
+// hand below from the geometry of the default scene, not taken from the code.
+//
+// Cart marker (AprilTag frame: x right as seen from the robot, y down, z into the board) at base
+// (0.959, 0.25, 0.37), facing the robot: x_t = -y_base, y_t = -z_base, z_t = +x_base. With
+// grasp_origin_in_marker_m = (-0.37, 0.30, -0.359) the grasp frame is X = +z_base, Y = -y_base,
+// Z = +x_base, origin (0.60, -0.05, 0.0) (the cart origin of config/scenes/default.yaml), so
+//     p_grasp = (z_b, -(y_b + 0.05), x_b - 0.60)   and   p_base = (0.60 + Z, -0.05 - Y, X).
+#include "services/arbiter/arbiter_node.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "common/composition.h"
+#include "common/config.h"
+#include "common/pose_conversion.h"
+#include "common/service_host.h"
+
+namespace bookgrasp {
+namespace {
+
+constexpr double kTol = 1e-9;
+
+template <typename Msg>
+struct Collector {
+  std::vector<Msg> got;
+  void on(const lcm::ReceiveBuffer*, const std::string&, const Msg* m) { got.push_back(*m); }
+};
+
+Config arbiter_config() {
+  return Config::load_file(std::string(BOOKGRASP_SOURCE_DIR) + "/config/services/arbiter.yaml");
+}
+
+Eigen::Matrix3d grasp_rotation() {
+  Eigen::Matrix3d r;
+  r.col(0) = Eigen::Vector3d(0, 0, 1);   // X up
+  r.col(1) = Eigen::Vector3d(0, -1, 0);  // Y right
+  r.col(2) = Eigen::Vector3d(1, 0, 0);   // Z into the shelf
+  return r;
+}
+
+marker_detections_t markers(int64_t utime) {
+  Eigen::Isometry3d t = Eigen::Isometry3d::Identity();
+  t.linear().col(0) = Eigen::Vector3d(0, -1, 0);
+  t.linear().col(1) = Eigen::Vector3d(0, 0, -1);
+  t.linear().col(2) = Eigen::Vector3d(1, 0, 0);
+  t.translation() = Eigen::Vector3d(0.959, 0.25, 0.37);
+  marker_t m;
+  m.utime = utime;
+  m.family = "tag36h11";
+  m.id = 0;
+  m.role = "cart";
+  m.pose_in_base = isometry_to_pose(t, "base", "cart", utime);
+  m.pose_in_camera = m.pose_in_base;
+  marker_detections_t d;
+  d.utime = utime;
+  d.implementation = "apriltag3";
+  d.camera_frame = "stereo_left";
+  d.markers = {m};
+  d.num_markers = 1;
+  return d;
+}
+
+book_corner_stereo_t corner(int64_t utime, const std::string& impl, bool found, Eigen::Vector3d p1_base) {
+  book_corner_stereo_t c;
+  c.utime = utime;
+  c.implementation = impl;
+  c.found = found;
+  c.failure_reason = found ? "" : "no candidate";
+  for (int i = 0; i < 3; ++i) {
+    c.p1_base[i] = p1_base[i];
+    c.p1_grasp[i] = 0;
+  }
+  c.num_regions = 0;
+  return c;
+}
+
+servo_request_t request(int64_t utime, int64_t id, int8_t mode, int rank = 0) {
+  servo_request_t r;
+  r.utime = utime;
+  r.request_id = id;
+  r.mode = mode;
+  r.start_pose = isometry_to_pose(Eigen::Isometry3d::Identity(), "base", "gripper", utime);
+  r.rank_from_right = rank;
+  r.timeout_s = 10;
+  return r;
+}
+
+servo_status_t status(int64_t utime, int64_t id, int8_t mode, int8_t state, Eigen::Vector3d pos_base,
+                      double slope = 0.0) {
+  servo_status_t s;
+  s.utime = utime;
+  s.request_id = id;
+  s.mode = mode;
+  s.state = state;
+  Eigen::Isometry3d t = Eigen::Isometry3d::Identity();
+  t.linear() = grasp_rotation() * Eigen::AngleAxisd(slope, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  t.translation() = pos_base;
+  s.converged_pose = isometry_to_pose(t, "base", "gripper", utime);
+  return s;
+}
+
+arm_state_t arm(int64_t utime, double width, bool contact) {
+  arm_state_t a;
+  a.utime = utime;
+  a.num_joints = 0;
+  a.end_effector = isometry_to_pose(Eigen::Isometry3d::Identity(), "base", "gripper", utime);
+  a.gripper_width_m = width;
+  a.gripper_contact = contact;
+  a.state = arm_state_t::IDLE;
+  return a;
+}
+
+void expect_vec(const double (&v)[3], const Eigen::Vector3d& want, const char* what) {
+  for (int i = 0; i < 3; ++i) EXPECT_NEAR(v[i], want[i], kTol) << what << "[" << i << "]";
+}
+
+bool starts_with(const std::string& s, const std::string& p) { return s.rfind(p, 0) == 0; }
+
+class ArbiterNodeTest : public testing::Test {
+ protected:
+  ArbiterNodeTest() {
+    node = &comp.add(std::make_unique<ArbiterNode>(arbiter_config()));
+    comp.bus().subscribe("GRASP_POINT", &Collector<grasp_point_t>::on, &out);
+  }
+  template <typename Msg>
+  void send(const std::string& channel, const Msg& m) {
+    comp.bus().publish(channel, &m);
+    comp.spin();
+  }
+  /// Markers, a P1 of `god` and a converged stripe servo giving PS.
+  void first_run(const Eigen::Vector3d& p1_base, const Eigen::Vector3d& ps_base) {
+    send("MARKERS", markers(1000));
+    send("BOOK_CORNER_STEREO", corner(2000, "god", true, p1_base));
+    send("SERVO_REQUEST", request(3000, 1, servo_request_t::STRIPE_END));
+    send("SERVO_STATUS", status(4000, 1, servo_request_t::STRIPE_END, servo_status_t::CONVERGED, ps_base));
+  }
+  Composition comp;
+  ArbiterNode* node = nullptr;
+  Collector<grasp_point_t> out;
+};
+
+TEST_F(ArbiterNodeTest, WholeBookP1ValidGraspWidthAndNextPs) {
+  // P1 base (0.61, -0.30, 0.25) -> grasp (0.25, 0.25, 0.01). PS base (0.45, -0.305, 0.10) -> (0.10, 0.255, -0.15).
+  first_run({0.61, -0.30, 0.25}, {0.45, -0.305, 0.10});
+  // Before PS: the P1 message answered NEED_PS. After PS: |0.25 - 0.255| = 5 mm <= 10 mm -> P1_VALID.
+  ASSERT_EQ(out.got.size(), 2u);
+  EXPECT_TRUE(starts_with(out.got[0].reason, "NEED_PS")) << out.got[0].reason;
+  const grasp_point_t& check = out.got[1];
+  EXPECT_TRUE(starts_with(check.reason, "P1_VALID")) << check.reason;
+  EXPECT_FALSE(check.valid);
+  EXPECT_TRUE(check.p1_used);
+  EXPECT_EQ(check.utime, 4000);
+  expect_vec(check.p1_grasp, {0.25, 0.25, 0.01}, "p1_grasp");
+  expect_vec(check.ps_grasp, {0.10, 0.255, -0.15}, "ps_grasp");
+  expect_vec(check.gp_grasp, {0.25, 0.25, 0.01}, "BwH start = P1");
+  EXPECT_NEAR(check.gp_base.position[0], 0.61, kTol);
+  EXPECT_NEAR(check.gp_base.position[1], -0.30, kTol);
+  EXPECT_NEAR(check.gp_base.position[2], 0.25, kTol);
+  EXPECT_EQ(check.num_steps, static_cast<int32_t>(check.steps.size()));
+
+  // BwH rank 0 converges at base (0.45, -0.31, 0.26) -> grasp (0.26, 0.26, -0.15): dy = +10 mm < 15,
+  // dx = +10 mm < 20 -> GP = (P2.x, P2.y, P1.z) = (0.26, 0.26, 0.01) -> base (0.61, -0.31, 0.26).
+  send("SERVO_REQUEST", request(5000, 2, servo_request_t::BOOK_CORNER, 0));
+  send("SERVO_STATUS", status(6000, 2, servo_request_t::BOOK_CORNER, servo_status_t::CONVERGED, {0.45, -0.31, 0.26}));
+  ASSERT_EQ(out.got.size(), 3u);
+  const grasp_point_t& gp = out.got[2];
+  EXPECT_TRUE(starts_with(gp.reason, "GRASP")) << gp.reason;
+  EXPECT_TRUE(gp.valid);
+  EXPECT_EQ(gp.utime, 6000);
+  EXPECT_EQ(gp.request_id, 2);
+  EXPECT_TRUE(gp.p1_used);
+  EXPECT_TRUE(gp.p2_used);
+  expect_vec(gp.gp_grasp, {0.26, 0.26, 0.01}, "gp_grasp");
+  expect_vec(gp.p2_grasp, {0.26, 0.26, -0.15}, "p2_grasp");
+  EXPECT_NEAR(gp.gp_base.position[0], 0.61, kTol);
+  EXPECT_NEAR(gp.gp_base.position[1], -0.31, kTol);
+  EXPECT_NEAR(gp.gp_base.position[2], 0.26, kTol);
+  const Eigen::Matrix3d r = pose_to_isometry(gp.gp_base).linear();
+  EXPECT_TRUE(r.isApprox(grasp_rotation(), 1e-9)) << "gripper frame = grasp frame (slope 0)\n" << r;
+  // Every rule of the strategy is in the trace, the P1 source first.
+  std::vector<std::string> rules;
+  for (const auto& s : gp.steps) rules.push_back(s.rule);
+  ASSERT_GE(rules.size(), 5u);
+  EXPECT_EQ(rules[0], "P1 source");
+  EXPECT_EQ(rules[1], "P1.y vs PS.y");
+  EXPECT_EQ(rules[2], "P2.y vs P1.y");
+  EXPECT_EQ(rules[3], "P2.x vs P1.x");
+  EXPECT_EQ(rules[4], "GP.z");
+  EXPECT_NEAR(gp.steps[2].value_m, 0.01, kTol);
+
+  // A repeated CONVERGED status of the same request is not decided twice.
+  send("SERVO_STATUS", status(6100, 2, servo_request_t::BOOK_CORNER, servo_status_t::CONVERGED, {0.45, -0.31, 0.26}));
+  EXPECT_EQ(out.got.size(), 3u);
+
+  // Gripper closes: contact at 25.4 mm (still closing), then 25.0 mm held for 0.3 s -> BW = 25 mm.
+  send("ARM_STATE", arm(7000, 0.040, false));
+  send("ARM_STATE", arm(8000, 0.0254, true));
+  send("ARM_STATE", arm(18000, 0.0250, true));
+  send("ARM_STATE", arm(118000, 0.0250, true));
+  EXPECT_EQ(out.got.size(), 3u) << "0.1 s steady is less than settle_s 0.2";
+  send("ARM_STATE", arm(318000, 0.0250, true));
+  ASSERT_EQ(out.got.size(), 4u);
+  const grasp_point_t& bw = out.got[3];
+  EXPECT_TRUE(starts_with(bw.reason, "BOOK_WIDTH")) << bw.reason;
+  EXPECT_TRUE(bw.valid) << "15 mm <= 25 mm <= 30 mm";
+  EXPECT_EQ(bw.request_id, 2);
+  // PS.y = GP.y - BW = 0.26 - 0.025 = 0.235; x, z kept from PS.
+  expect_vec(bw.ps_grasp, {0.10, 0.235, -0.15}, "next PS");
+  send("ARM_STATE", arm(400000, 0.0250, true));
+  EXPECT_EQ(out.got.size(), 4u) << "the width is measured once per grasp";
+
+  // Next book: P1 base (0.61, -0.285, 0.18) -> grasp (0.18, 0.235, 0.01): 0 mm from the updated PS.
+  send("BOOK_CORNER_STEREO", corner(500000, "god", true, {0.61, -0.285, 0.18}));
+  ASSERT_EQ(out.got.size(), 5u);
+  EXPECT_TRUE(starts_with(out.got[4].reason, "P1_VALID")) << out.got[4].reason;
+  EXPECT_NEAR(out.got[4].steps[1].value_m, 0.0, kTol);
+}
+
+TEST_F(ArbiterNodeTest, FalseRegionAsksForNextRankThenGrasps) {
+  first_run({0.61, -0.30, 0.25}, {0.45, -0.305, 0.10});
+  // Rank 0 converges 30 mm right of P1 (grasp y 0.28, base y -0.33): false region -> NEXT_REGION rank 1.
+  send("SERVO_REQUEST", request(5000, 2, servo_request_t::BOOK_CORNER, 0));
+  send("SERVO_STATUS", status(6000, 2, servo_request_t::BOOK_CORNER, servo_status_t::CONVERGED, {0.45, -0.33, 0.25}));
+  ASSERT_EQ(out.got.size(), 3u);
+  EXPECT_TRUE(starts_with(out.got[2].reason, "NEXT_REGION rank 1")) << out.got[2].reason;
+  EXPECT_FALSE(out.got[2].valid);
+  // A new BwS frame during the servo (arm in view) must not replace the frozen P1 or answer a check.
+  send("BOOK_CORNER_STEREO", corner(6500, "god", true, {0.61, -0.10, 0.40}));
+  EXPECT_EQ(out.got.size(), 3u);
+  // Rank 1 converges 20 mm LEFT of P1 and 30 mm BELOW it: P2.y accepted (P1 right of P2), P2.x = P1.x.
+  // P2 grasp (0.22, 0.23, -0.15) -> GP = (0.25, 0.23, 0.01).
+  send("SERVO_REQUEST", request(7000, 3, servo_request_t::BOOK_CORNER, 1));
+  send("SERVO_STATUS", status(8000, 3, servo_request_t::BOOK_CORNER, servo_status_t::CONVERGED, {0.45, -0.28, 0.22}));
+  ASSERT_EQ(out.got.size(), 4u);
+  EXPECT_TRUE(starts_with(out.got[3].reason, "GRASP")) << out.got[3].reason;
+  expect_vec(out.got[3].gp_grasp, {0.25, 0.23, 0.01}, "gp after rank 1");
+  expect_vec(out.got[3].p1_grasp, {0.25, 0.25, 0.01}, "frozen P1");
+}
+
+TEST_F(ArbiterNodeTest, NoRegionLeftGivesNoGrasp) {
+  first_run({0.61, -0.30, 0.25}, {0.45, -0.305, 0.10});
+  send("SERVO_REQUEST", request(5000, 2, servo_request_t::BOOK_CORNER, 2));
+  send("SERVO_STATUS", status(6000, 2, servo_request_t::BOOK_CORNER, servo_status_t::CONVERGED, {0.45, -0.33, 0.25}));
+  ASSERT_EQ(out.got.size(), 3u);
+  EXPECT_TRUE(starts_with(out.got[2].reason, "NO_GRASP")) << out.got[2].reason;
+  EXPECT_NE(out.got[2].reason.find("max_rank 3"), std::string::npos) << out.got[2].reason;
+}
+
+TEST_F(ArbiterNodeTest, InvalidP1StartsBwhFromPsAndTakesZFromCartModel) {
+  // P1 base y -0.325 -> grasp y 0.275, 20 mm from PS.y 0.255 -> invalid; BwH starts from PS.
+  first_run({0.61, -0.325, 0.25}, {0.45, -0.305, 0.10});
+  ASSERT_EQ(out.got.size(), 2u);
+  EXPECT_TRUE(starts_with(out.got[1].reason, "P1_INVALID")) << out.got[1].reason;
+  EXPECT_FALSE(out.got[1].p1_used);
+  expect_vec(out.got[1].gp_grasp, {0.10, 0.255, -0.15}, "BwH start = PS");
+  // P2 grasp (0.24, 0.26, -0.15): 5 mm right of PS -> valid; no P1 -> X as is, Z = book_front_z_m 0.01.
+  send("SERVO_REQUEST", request(5000, 2, servo_request_t::BOOK_CORNER, 0));
+  send("SERVO_STATUS", status(6000, 2, servo_request_t::BOOK_CORNER, servo_status_t::CONVERGED, {0.45, -0.31, 0.24}));
+  ASSERT_EQ(out.got.size(), 3u);
+  EXPECT_TRUE(starts_with(out.got[2].reason, "GRASP")) << out.got[2].reason;
+  EXPECT_FALSE(out.got[2].p1_used);
+  expect_vec(out.got[2].gp_grasp, {0.24, 0.26, 0.01}, "gp without P1");
+}
+
+TEST_F(ArbiterNodeTest, ServoFailureIsNoGraspAndOpensANewAttempt) {
+  first_run({0.61, -0.30, 0.25}, {0.45, -0.305, 0.10});
+  send("SERVO_REQUEST", request(5000, 2, servo_request_t::BOOK_CORNER, 0));
+  send("SERVO_STATUS", status(6000, 2, servo_request_t::BOOK_CORNER, servo_status_t::FEATURE_LOST, {0, 0, 0}));
+  ASSERT_EQ(out.got.size(), 3u);
+  EXPECT_TRUE(starts_with(out.got[2].reason, "NO_GRASP")) << out.got[2].reason;
+  EXPECT_NE(out.got[2].reason.find("did not converge"), std::string::npos);
+  // The next attempt answers P1 checks again (P1 no longer frozen).
+  send("BOOK_CORNER_STEREO", corner(7000, "god", true, {0.61, -0.30, 0.25}));
+  ASSERT_EQ(out.got.size(), 4u);
+  EXPECT_TRUE(starts_with(out.got[3].reason, "P1_VALID")) << out.got[3].reason;
+}
+
+TEST_F(ArbiterNodeTest, CancelReopensTheAttempt) {
+  first_run({0.61, -0.30, 0.25}, {0.45, -0.305, 0.10});
+  send("BOOK_CORNER_STEREO", corner(4500, "god", true, {0.61, -0.30, 0.25}));
+  EXPECT_EQ(out.got.size(), 2u) << "frozen by the stripe request";
+  send("SERVO_REQUEST", request(5000, 0, servo_request_t::CANCEL));
+  send("BOOK_CORNER_STEREO", corner(6000, "god", true, {0.61, -0.30, 0.25}));
+  ASSERT_EQ(out.got.size(), 3u);
+  EXPECT_TRUE(starts_with(out.got[2].reason, "P1_VALID")) << out.got[2].reason;
+}
+
+TEST_F(ArbiterNodeTest, SlopeOfTheServoTurnsTheGripperAboutZ) {
+  first_run({0.61, -0.30, 0.25}, {0.45, -0.305, 0.10});
+  send("SERVO_REQUEST", request(5000, 2, servo_request_t::BOOK_CORNER, 0));
+  send("SERVO_STATUS",
+       status(6000, 2, servo_request_t::BOOK_CORNER, servo_status_t::CONVERGED, {0.45, -0.31, 0.26}, 0.05));
+  ASSERT_EQ(out.got.size(), 3u);
+  EXPECT_NEAR(out.got[2].slope_rad, 0.05, 1e-9);
+  // Gripper x = cos(0.05) X + sin(0.05) Y = (0, -sin 0.05, cos 0.05) in base.
+  const Eigen::Matrix3d r = pose_to_isometry(out.got[2].gp_base).linear();
+  EXPECT_NEAR(r(0, 0), 0.0, 1e-9);
+  EXPECT_NEAR(r(1, 0), -std::sin(0.05), 1e-9);
+  EXPECT_NEAR(r(2, 0), std::cos(0.05), 1e-9);
+}
+
+TEST_F(ArbiterNodeTest, DetectorSwitchSelectsTheImplementationAndShows) {
+  send("MARKERS", markers(1000));
+  send("SERVO_REQUEST", request(1500, 1, servo_request_t::STRIPE_END));
+  send("SERVO_STATUS", status(1600, 1, servo_request_t::STRIPE_END, servo_status_t::CONVERGED, {0.45, -0.305, 0.10}));
+  ASSERT_EQ(out.got.size(), 1u);  // P1 check without P1: invalid, start from PS
+  EXPECT_TRUE(starts_with(out.got[0].reason, "P1_INVALID")) << out.got[0].reason;
+  send("SERVO_REQUEST", request(1700, 0, servo_request_t::CANCEL));
+  send("BOOK_CORNER_STEREO", corner(2000, "pcl", true, {0.61, -0.30, 0.25}));
+  EXPECT_EQ(out.got.size(), 1u) << "pcl is not followed yet";
+  detector_switch_t sw;
+  sw.utime = 2500;
+  sw.logical_channel = "BOOK_CORNER_STEREO";
+  sw.implementation = "pcl";
+  sw.reason = "operator test";
+  send("DETECTOR_SWITCH", sw);
+  EXPECT_EQ(node->followed_implementation(), "pcl");
+  EXPECT_NE(node->last_error().find("now following BOOK_CORNER_STEREO implementation 'pcl'"), std::string::npos)
+      << node->last_error();
+  send("BOOK_CORNER_STEREO", corner(3000, "god", true, {0.61, -0.30, 0.25}));
+  EXPECT_EQ(out.got.size(), 1u) << "god is no longer followed";
+  send("BOOK_CORNER_STEREO", corner(3100, "pcl", true, {0.61, -0.30, 0.25}));
+  ASSERT_EQ(out.got.size(), 2u);
+  EXPECT_TRUE(starts_with(out.got[1].reason, "P1_VALID")) << out.got[1].reason;
+  EXPECT_NE(out.got[1].reason.find("'pcl'"), std::string::npos) << out.got[1].reason;
+  EXPECT_EQ(out.got[1].steps[0].rule, "P1 source");
+  EXPECT_NE(out.got[1].steps[0].decision.find("operator test"), std::string::npos);
+  // A switch for another logical channel changes nothing.
+  sw.logical_channel = "BOOK_FEATURES_HAND";
+  sw.implementation = "other";
+  send("DETECTOR_SWITCH", sw);
+  EXPECT_EQ(node->followed_implementation(), "pcl");
+}
+
+TEST_F(ArbiterNodeTest, BadInputsAreRejectedAndTheNodeGoesOn) {
+  constexpr double kNan = std::numeric_limits<double>::quiet_NaN();
+  send("MARKERS", markers(1000));
+  const uint8_t garbage[] = {1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15, 16, 17, 18};
+  comp.bus().publish("BOOK_CORNER_STEREO", garbage, sizeof(garbage));
+  comp.spin();
+  send("BOOK_CORNER_STEREO", corner(1100, "god", true, {kNan, 0, 0}));
+  auto bad_markers = markers(1200);
+  bad_markers.markers[0].pose_in_base.orientation[0] = 0;
+  bad_markers.markers[0].pose_in_base.orientation[1] = 0;
+  bad_markers.markers[0].pose_in_base.orientation[2] = 0;
+  bad_markers.markers[0].pose_in_base.orientation[3] = 0;
+  send("MARKERS", bad_markers);
+  send("SERVO_REQUEST", request(1300, 5, 9));
+  auto bad_status = status(1400, 1, servo_request_t::STRIPE_END, servo_status_t::CONVERGED, {kNan, 0, 0});
+  send("SERVO_STATUS", bad_status);
+  send("ARM_STATE", arm(1500, kNan, true));
+  detector_switch_t sw;
+  sw.utime = 1600;
+  sw.logical_channel = "BOOK_CORNER_STEREO";
+  sw.implementation = "";
+  send("DETECTOR_SWITCH", sw);
+  EXPECT_EQ(node->rejected_total(), 7);
+  EXPECT_TRUE(out.got.empty());
+  // Still works: the earlier good marker frame is kept.
+  send("BOOK_CORNER_STEREO", corner(2000, "god", true, {0.61, -0.30, 0.25}));
+  send("SERVO_REQUEST", request(3000, 1, servo_request_t::STRIPE_END));
+  send("SERVO_STATUS", status(4000, 1, servo_request_t::STRIPE_END, servo_status_t::CONVERGED, {0.45, -0.305, 0.10}));
+  ASSERT_EQ(out.got.size(), 2u);
+  EXPECT_TRUE(starts_with(out.got[1].reason, "P1_VALID")) << out.got[1].reason;
+}
+
+TEST_F(ArbiterNodeTest, SameInputsGiveTheSameOutputsBitForBit) {
+  auto run = [](std::vector<std::vector<uint8_t>>* encoded) {
+    Composition c;
+    c.add(std::make_unique<ArbiterNode>(arbiter_config()));
+    Collector<grasp_point_t> col;
+    c.bus().subscribe("GRASP_POINT", &Collector<grasp_point_t>::on, &col);
+    auto pub = [&](const std::string& ch, const auto& m) {
+      c.bus().publish(ch, &m);
+      c.spin();
+    };
+    pub("MARKERS", markers(1000));
+    pub("BOOK_CORNER_STEREO", corner(2000, "god", true, {0.61, -0.30, 0.25}));
+    pub("SERVO_REQUEST", request(3000, 1, servo_request_t::STRIPE_END));
+    pub("SERVO_STATUS", status(4000, 1, servo_request_t::STRIPE_END, servo_status_t::CONVERGED, {0.45, -0.305, 0.10}));
+    pub("SERVO_REQUEST", request(5000, 2, servo_request_t::BOOK_CORNER, 0));
+    pub("SERVO_STATUS", status(6000, 2, servo_request_t::BOOK_CORNER, servo_status_t::CONVERGED, {0.45, -0.31, 0.26}, 0.02));
+    for (const auto& g : col.got) {
+      std::vector<uint8_t> buf(g.getEncodedSize());
+      g.encode(buf.data(), 0, static_cast<int>(buf.size()));
+      encoded->push_back(buf);
+    }
+  };
+  std::vector<std::vector<uint8_t>> a, b;
+  run(&a);
+  run(&b);
+  ASSERT_EQ(a.size(), 3u);
+  EXPECT_EQ(a, b);
+}
+
+TEST(ArbiterConfig, ShippedConfigReadsCompletelyAndBadValuesNameTheKey) {
+  const Config cfg = arbiter_config();
+  ServiceSettings::from_config(cfg);
+  ArbiterNode node(cfg);
+  EXPECT_NO_THROW(cfg.require_all_read());
+  std::string text = cfg.dump();
+  const auto pos = text.find("y_m: 0.015");
+  ASSERT_NE(pos, std::string::npos);
+  text.replace(pos, 10, "y_m: -1");
+  try {
+    ArbiterNode bad(Config::from_string(text, "arbiter.yaml"));
+    FAIL() << "a negative tolerance must be refused";
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("tolerances.y_m"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace bookgrasp
