@@ -1,0 +1,251 @@
+#include "services/visual_servo/servo_session.h"
+
+#include <cmath>
+#include <cstdio>
+
+namespace bookgrasp {
+
+namespace {
+int64_t seconds_to_us(double s) { return static_cast<int64_t>(std::llround(s * 1e6)); }
+std::string fmt(const char* f, double a, double b = 0, double c = 0) {
+  char buf[256];
+  std::snprintf(buf, sizeof(buf), f, a, b, c);
+  return buf;
+}
+}  // namespace
+
+std::string servo_state_name(ServoState s) {
+  switch (s) {
+    case ServoState::kIdle: return "IDLE";
+    case ServoState::kRunning: return "RUNNING";
+    case ServoState::kConverged: return "CONVERGED";
+    case ServoState::kFeatureLost: return "FEATURE_LOST";
+    case ServoState::kTimeout: return "TIMEOUT";
+    case ServoState::kFailed: return "FAILED";
+    case ServoState::kCancelled: return "CANCELLED";
+  }
+  return "?";
+}
+
+ServoSession::ServoSession(const HandEyeGeometry& geometry, const ServoSessionParams& session,
+                           const BookCornerServoParams& corner, const StripeEndServoParams& stripe)
+    : geo_(geometry), p_(session), corner_(geometry, corner), stripe_(geometry, stripe) {}
+
+ServoReport ServoSession::report(ServoState state, const std::string& message) const {
+  ServoReport r;
+  r.utime = now_;
+  r.request_id = request_id_;
+  r.mode = mode_;
+  r.state = state;
+  r.iterations = iterations_;
+  r.error_px = error_px_;
+  r.slope_error_rad = slope_error_;
+  r.message = message;
+  return r;
+}
+
+void ServoSession::command(const GripperTwist& twist, SessionOutput* out) {
+  twist_ = twist;
+  ServoCommand c;
+  c.utime = now_;
+  c.twist = twist;
+  out->commands.push_back(c);
+  last_command_utime_ = now_;
+}
+
+void ServoSession::finish(ServoState state, const std::string& message, SessionOutput* out,
+                          const std::optional<Eigen::Isometry3d>& pose) {
+  if (!running_) return;
+  running_ = false;
+  twist_.setZero();
+  ServoCommand c;
+  c.utime = now_;
+  c.stop = true;
+  c.reason = "visual_servo: " + servo_state_name(state) + ": " + message;
+  out->commands.push_back(c);
+  ServoReport r = report(state, message);
+  r.converged_pose = pose;
+  out->reports.push_back(r);
+}
+
+std::optional<Eigen::Isometry3d> ServoSession::pose_at(int64_t utime) const {
+  if (history_.empty()) return std::nullopt;
+  // The last pose at or before `utime`; the oldest one if all are later.
+  for (auto it = history_.rbegin(); it != history_.rend(); ++it)
+    if (it->first <= utime) return it->second;
+  return history_.front().second;
+}
+
+void ServoSession::advance(int64_t utime, SessionOutput* out) {
+  if (utime > now_) now_ = utime;
+  if (!running_) return;
+  if (now_ >= deadline_utime_) {
+    finish(ServoState::kTimeout,
+           fmt("no convergence within %.2f s (message time) after %.0f iterations", (deadline_utime_ - start_utime_) * 1e-6,
+               iterations_),
+           out);
+    return;
+  }
+  const double since_good = (now_ - last_good_utime_) * 1e-6;
+  if (since_good > p_.feature_lost_timeout_s) {
+    std::string why = last_lost_reason_.empty() ? "no feature measurement arrived" : last_lost_reason_;
+    finish(ServoState::kFeatureLost,
+           fmt("feature lost for %.2f s (feature_lost_timeout_s %.2f): ", since_good, p_.feature_lost_timeout_s) + why,
+           out);
+    return;
+  }
+  const bool stale = since_good > p_.stale_feature_s;
+  if (stale && !holding_) {
+    holding_ = true;
+    command(GripperTwist::Zero(), out);
+    return;
+  }
+  if (last_command_utime_ == INT64_MIN || (now_ - last_command_utime_) * 1e-6 >= p_.command_period_s) command(stale ? GripperTwist::Zero() : twist_, out);
+}
+
+SessionOutput ServoSession::on_request(const ServoRequest& request) {
+  SessionOutput out;
+  if (request.mode == ServoMode::kCancel) {
+    if (running_) {
+      finish(ServoState::kCancelled, "cancelled by request " + std::to_string(request.request_id), &out);
+    } else {
+      ServoReport r = report(ServoState::kIdle, "cancel: no task running");
+      r.request_id = request.request_id;
+      out.reports.push_back(r);
+    }
+    return out;
+  }
+  if (running_) finish(ServoState::kCancelled, "replaced by request " + std::to_string(request.request_id), &out);
+  mode_ = request.mode;
+  request_id_ = request.request_id;
+  iterations_ = 0;
+  error_px_.setZero();
+  slope_error_ = 0;
+  if (!have_arm_) {
+    running_ = true;
+    finish(ServoState::kFailed, "no ARM_STATE received yet: start the arm driver before servoing", &out);
+    return out;
+  }
+  if (request.start_pose) {
+    const double d = (request.start_pose->translation() - tcp_.translation()).norm();
+    if (d > p_.max_start_error_m) {
+      running_ = true;
+      finish(ServoState::kFailed,
+             fmt("the TCP is %.3f m from start_pose (max_start_error_m %.3f): move the arm there first (planner), "
+                 "or send start_pose with an empty frame to start where it is",
+                 d, p_.max_start_error_m),
+             &out);
+      return out;
+    }
+  }
+  const bool corner = mode_ == ServoMode::kBookCorner;
+  standoff_ = request.standoff_m > 0 ? request.standoff_m
+                                     : (corner ? p_.default_corner_standoff_m : p_.default_stripe_standoff_m);
+  rank_ = request.rank_from_right;
+  start_utime_ = now_;
+  deadline_utime_ = now_ + seconds_to_us(request.timeout_s > 0 ? request.timeout_s : p_.default_timeout_s);
+  last_good_utime_ = now_;
+  last_measurement_utime_ = now_;
+  last_command_utime_ = INT64_MIN;
+  arm_executing_seen_ = false;
+  holding_ = false;
+  last_lost_reason_.clear();
+  start_position_ = tcp_.translation();
+  twist_.setZero();
+  corner_.reset();
+  stripe_.reset();
+  running_ = true;
+  out.reports.push_back(report(ServoState::kRunning, std::string("started ") + (corner ? "BOOK_CORNER" : "STRIPE_END") +
+                                                         fmt(" at standoff %.3f m", standoff_)));
+  return out;
+}
+
+SessionOutput ServoSession::on_arm_state(int64_t utime, const Eigen::Isometry3d& tcp_in_base, ArmCondition condition,
+                                         const std::string& arm_message) {
+  SessionOutput out;
+  have_arm_ = true;
+  tcp_ = tcp_in_base;
+  history_.emplace_back(utime, tcp_in_base);
+  while (!history_.empty() && history_.front().first < utime - seconds_to_us(p_.pose_history_s)) history_.pop_front();
+  if (utime > now_) now_ = utime;
+  if (running_) {
+    if (condition == ArmCondition::kExecuting && last_command_utime_ != INT64_MIN) arm_executing_seen_ = true;
+    if (condition == ArmCondition::kFault ||
+        (condition == ArmCondition::kStopped && arm_executing_seen_)) {
+      finish(ServoState::kFailed, "the arm driver stopped: " + arm_message, &out);
+      return out;
+    }
+  }
+  advance(utime, &out);
+  return out;
+}
+
+bool ServoSession::accept_measurement_time(int64_t utime) {
+  if (!running_) return false;
+  if (utime < start_utime_) return false;              // image taken before the task started
+  if (utime <= last_measurement_utime_ && iterations_ > 0) return false;  // repeated / out of order
+  last_measurement_utime_ = utime;
+  return true;
+}
+
+SessionOutput ServoSession::on_book(const BookObservation& obs) {
+  SessionOutput out;
+  advance(obs.utime, &out);
+  if (!running_ || mode_ != ServoMode::kBookCorner) return out;
+  if (obs.rank_from_right != rank_) return out;  // answers an older rank request
+  if (!accept_measurement_time(obs.utime)) return out;
+  if (!obs.found || !obs.r_px.allFinite() || !std::isfinite(obs.slope_rad)) {
+    last_lost_reason_ = "BwH: " + (obs.failure_reason.empty() ? std::string("no book found") : obs.failure_reason);
+    out.reports.push_back(report(ServoState::kRunning, "feature not seen: " + last_lost_reason_));
+    return out;
+  }
+  const CornerServoStep s = corner_.step(obs.r_px, obs.slope_rad, standoff_);
+  ++iterations_;
+  error_px_ = s.error_px;
+  slope_error_ = s.slope_error_rad;
+  last_good_utime_ = std::max(last_good_utime_, obs.utime);
+  holding_ = false;
+  if (s.converged) {
+    finish(ServoState::kConverged, fmt("R within %.2f px of the target (%.1f, %.1f)", s.error_px.norm(),
+                                       s.target_px.x(), s.target_px.y()),
+           &out, pose_at(obs.utime));
+    return out;
+  }
+  command(s.twist, &out);
+  out.reports.push_back(report(ServoState::kRunning, "tracking R"));
+  return out;
+}
+
+SessionOutput ServoSession::on_stripe(int64_t utime, const StripeObservation& obs, const std::string& failure_reason) {
+  SessionOutput out;
+  advance(utime, &out);
+  if (!running_ || mode_ != ServoMode::kStripeEnd) return out;
+  if (!accept_measurement_time(utime)) return out;
+  const double travelled = (tcp_.translation() - start_position_).norm();
+  const StripeServoStep s = stripe_.step(obs, standoff_, travelled);
+  if (s.failed) {
+    finish(ServoState::kFeatureLost, s.note, &out);
+    return out;
+  }
+  if (!s.measured) {
+    last_lost_reason_ = "BSwH: " + (failure_reason.empty() ? s.note : failure_reason);
+    out.reports.push_back(report(ServoState::kRunning, "feature not seen: " + last_lost_reason_));
+    return out;
+  }
+  ++iterations_;
+  error_px_ = s.error_px;
+  slope_error_ = 0;
+  last_good_utime_ = std::max(last_good_utime_, utime);
+  holding_ = false;
+  if (s.converged) {
+    finish(ServoState::kConverged, fmt("stripe end within (%.1f, %.1f) mm of the TCP axis", s.error_m.x() * 1e3,
+                                       s.error_m.y() * 1e3),
+           &out, pose_at(utime));
+    return out;
+  }
+  command(s.twist, &out);
+  out.reports.push_back(report(ServoState::kRunning, s.note));
+  return out;
+}
+
+}  // namespace bookgrasp

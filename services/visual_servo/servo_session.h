@@ -1,0 +1,168 @@
+#pragma once
+/// @file
+/// One visual-servoing task at a time, in message time: a request starts it,
+/// feature measurements drive the corner (IBVS) or stripe (PBVS) servo, arm
+/// states give the clock and the end-effector pose; out come velocity/stop
+/// commands and progress reports. Pure: plain structs in and out, no LCM.
+///
+/// Timing (all message time, the largest utime seen on any input):
+///  - every usable measurement gives a new CARTESIAN_VELOCITY command;
+///  - while running, the current command is repeated at least every
+///    command_period_s (the arm driver stops without a command/heartbeat);
+///  - no usable measurement for stale_feature_s: the command becomes zero
+///    velocity (the arm holds still, waiting);
+///  - no usable measurement for feature_lost_timeout_s: STOP, FEATURE_LOST with
+///    the detector's reason;
+///  - the task's timeout: STOP, TIMEOUT; converged: STOP, CONVERGED with the
+///    end-effector pose at the converging image's capture time.
+
+#include <cstdint>
+#include <deque>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Geometry>
+
+#include "services/visual_servo/book_corner_servo.h"
+#include "services/visual_servo/hand_eye_geometry.h"
+#include "services/visual_servo/stripe_end_servo.h"
+
+namespace bookgrasp {
+
+/// Task kinds (numbers as servo_request_t modes).
+enum class ServoMode { kCancel = 0, kBookCorner = 1, kStripeEnd = 2 };
+/// Task states (numbers as servo_status_t states).
+enum class ServoState { kIdle = 0, kRunning = 1, kConverged = 2, kFeatureLost = 3, kTimeout = 4, kFailed = 5, kCancelled = 6 };
+
+/// Name of a state ("IDLE", "RUNNING", ...).
+std::string servo_state_name(ServoState s);
+
+/// Timing and start checks of a task (from configuration).
+struct ServoSessionParams {
+  double feature_lost_timeout_s = 0.6;    ///< no usable measurement this long -> STOP, FEATURE_LOST
+  double stale_feature_s = 0.25;          ///< no usable measurement this long -> zero velocity
+  double command_period_s = 0.05;         ///< repeat the command at least this often
+  double default_timeout_s = 20.0;        ///< when the request gives timeout_s <= 0
+  double max_start_error_m = 0.02;        ///< TCP this far from the request's start_pose -> FAILED
+  double default_corner_standoff_m = 0.2; ///< TCP to book front when the request gives fixed_depth_m <= 0
+  double default_stripe_standoff_m = 0.5; ///< TCP to rear board when the request gives fixed_depth_m <= 0
+  double pose_history_s = 1.0;            ///< end-effector poses kept to look up the pose at capture time
+};
+
+/// A start/cancel request (servo_request_t without LCM).
+struct ServoRequest {
+  int64_t utime = 0;
+  int64_t request_id = 0;
+  ServoMode mode = ServoMode::kCancel;
+  std::optional<Eigen::Isometry3d> start_pose;  ///< checked against the arm if given
+  double standoff_m = 0;        ///< fixed_depth_m: TCP to the observed plane (<= 0: configured default)
+  int rank_from_right = 0;      ///< BwH rank the features must carry
+  double timeout_s = 0;         ///< <= 0: configured default
+};
+
+/// A BwH measurement (book_features_hand_t fields the servo uses).
+struct BookObservation {
+  int64_t utime = 0;
+  bool found = false;
+  std::string failure_reason;
+  int rank_from_right = 0;
+  Eigen::Vector2d r_px = Eigen::Vector2d::Zero();
+  double slope_rad = 0;
+};
+
+/// A command for the arm driver.
+struct ServoCommand {
+  int64_t utime = 0;
+  bool stop = false;                          ///< STOP (else CARTESIAN_VELOCITY in the gripper frame)
+  GripperTwist twist = GripperTwist::Zero();  ///< velocity command
+  std::string reason;                         ///< why (stop)
+};
+
+/// A progress report (servo_status_t without LCM).
+struct ServoReport {
+  int64_t utime = 0;
+  int64_t request_id = 0;
+  ServoMode mode = ServoMode::kCancel;
+  ServoState state = ServoState::kIdle;
+  int iterations = 0;
+  Eigen::Vector2d error_px = Eigen::Vector2d::Zero();
+  double slope_error_rad = 0;
+  std::optional<Eigen::Isometry3d> converged_pose;  ///< P2 or PS (CONVERGED only)
+  std::string message;
+};
+
+/// What one input produced.
+struct SessionOutput {
+  std::vector<ServoCommand> commands;
+  std::vector<ServoReport> reports;
+};
+
+/// Arm driver state as the session needs it.
+enum class ArmCondition { kIdle, kExecuting, kStopped, kFault };
+
+/// The servo task state machine.
+class ServoSession {
+ public:
+  ServoSession(const HandEyeGeometry& geometry, const ServoSessionParams& session, const BookCornerServoParams& corner,
+               const StripeEndServoParams& stripe);
+
+  /// Starts (BOOK_CORNER, STRIPE_END) or cancels a task. A new task replaces a running one (reported CANCELLED).
+  SessionOutput on_request(const ServoRequest& request);
+  /// An arm state: the clock, the TCP pose in base, and the driver's condition and message.
+  SessionOutput on_arm_state(int64_t utime, const Eigen::Isometry3d& tcp_in_base, ArmCondition condition,
+                             const std::string& arm_message);
+  /// A BwH measurement.
+  SessionOutput on_book(const BookObservation& obs);
+  /// A BSwH measurement; `failure_reason` is the detector's text when nothing usable was seen.
+  SessionOutput on_stripe(int64_t utime, const StripeObservation& obs, const std::string& failure_reason);
+
+  /// True while a task runs.
+  bool running() const { return running_; }
+  /// Mode of the current (or last) task.
+  ServoMode mode() const { return mode_; }
+  /// The geometry.
+  const HandEyeGeometry& geometry() const { return geo_; }
+  /// Message time now (largest utime seen).
+  int64_t now_utime() const { return now_; }
+
+ private:
+  void advance(int64_t utime, SessionOutput* out);
+  void finish(ServoState state, const std::string& message, SessionOutput* out,
+              const std::optional<Eigen::Isometry3d>& pose = std::nullopt);
+  void command(const GripperTwist& twist, SessionOutput* out);
+  ServoReport report(ServoState state, const std::string& message) const;
+  std::optional<Eigen::Isometry3d> pose_at(int64_t utime) const;
+  bool accept_measurement_time(int64_t utime);
+
+  HandEyeGeometry geo_;
+  ServoSessionParams p_;
+  BookCornerServo corner_;
+  StripeEndServo stripe_;
+
+  int64_t now_ = INT64_MIN;
+  bool have_arm_ = false;
+  Eigen::Isometry3d tcp_ = Eigen::Isometry3d::Identity();
+  std::deque<std::pair<int64_t, Eigen::Isometry3d>> history_;
+
+  bool running_ = false;
+  ServoMode mode_ = ServoMode::kCancel;
+  int64_t request_id_ = 0;
+  int rank_ = 0;
+  double standoff_ = 0;
+  int64_t start_utime_ = 0;
+  int64_t deadline_utime_ = 0;
+  int64_t last_good_utime_ = 0;
+  int64_t last_measurement_utime_ = INT64_MIN;
+  int64_t last_command_utime_ = INT64_MIN;
+  bool arm_executing_seen_ = false;
+  bool holding_ = false;
+  Eigen::Vector3d start_position_ = Eigen::Vector3d::Zero();
+  GripperTwist twist_ = GripperTwist::Zero();
+  int iterations_ = 0;
+  Eigen::Vector2d error_px_ = Eigen::Vector2d::Zero();
+  double slope_error_ = 0;
+  std::string last_lost_reason_;
+};
+
+}  // namespace bookgrasp

@@ -1,0 +1,99 @@
+#include "services/visual_servo/stripe_end_servo.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+#include "services/visual_servo/book_corner_servo.h"
+
+namespace bookgrasp {
+
+StripeEndServo::StripeEndServo(const HandEyeGeometry& geometry, const StripeEndServoParams& params)
+    : geo_(geometry), p_(params) {}
+
+void StripeEndServo::reset() {
+  phase_ = StripePhase::kSearch;
+  occlusion_seen_ = false;
+  in_tolerance_ = 0;
+}
+
+StripeServoStep StripeEndServo::step(const StripeObservation& obs, double standoff_m, double travelled_m) {
+  StripeServoStep out;
+  out.target_px = geo_.target_pixel(standoff_m);
+  const double ut = out.target_px.x();
+
+  if (phase_ == StripePhase::kSearch) {
+    const bool covers_target =
+        obs.found && ut >= std::min(obs.line_start_px.x(), obs.line_end_px.x()) - 1.0 &&
+        ut <= std::max(obs.line_start_px.x(), obs.line_end_px.x()) + 1.0;
+    if (!covers_target) occlusion_seen_ = true;
+    bool accept = false;
+    if (obs.end_found) {
+      if (p_.search_direction > 0) {
+        accept = (occlusion_seen_ || !p_.require_occlusion) && obs.end_px.x() >= ut - 1.0;
+      } else {
+        accept = (occlusion_seen_ || !p_.require_occlusion) && obs.end_px.x() <= ut + 1.0;
+      }
+    }
+    if (accept) {
+      phase_ = StripePhase::kTrack;
+      in_tolerance_ = 0;
+    } else {
+      if (travelled_m > p_.max_search_distance_m) {
+        out.failed = true;
+        char buf[160];
+        std::snprintf(buf, sizeof(buf), "no stripe end found after %.2f m of search along the stripe (max_search_distance_m %.2f)",
+                      travelled_m, p_.max_search_distance_m);
+        out.note = buf;
+        return out;
+      }
+      GripperTwist t = GripperTwist::Zero();
+      t(1) = p_.search_speed * p_.search_direction;
+      if (obs.found) {
+        // Keep the stripe's centre line at the target row (height of the TCP = stripe height).
+        const Eigen::Vector2d a = obs.line_start_px, b = obs.line_end_px;
+        const double dx = b.x() - a.x();
+        const double v = std::abs(dx) > 1e-6 ? a.y() + (ut - a.x()) * (b.y() - a.y()) / dx : 0.5 * (a.y() + b.y());
+        Eigen::Vector3d p;
+        if (geo_.pixel_on_plane(Eigen::Vector2d(ut, v), standoff_m, &p)) {
+          t(0) = std::clamp(p_.gain * p.x(), -p_.max_linear_speed, p_.max_linear_speed);
+          out.error_px.y() = v - out.target_px.y();
+        }
+      }
+      out.twist = t;
+      out.phase = phase_;
+      out.note = obs.end_found ? "searching: an end seen but not accepted yet (behind the search direction or "
+                                 "before the books hid the stripe)"
+                               : (obs.found ? "searching: stripe seen, no end" : "searching: stripe hidden");
+      return out;
+    }
+  }
+
+  // TRACK
+  out.phase = phase_;
+  if (!obs.end_found) {
+    out.measured = false;
+    in_tolerance_ = 0;
+    out.note = obs.found ? "stripe seen but its end is outside the image" : "stripe not visible";
+    return out;
+  }
+  out.error_px = obs.end_px - out.target_px;
+  Eigen::Vector3d p;
+  if (!geo_.pixel_on_plane(obs.end_px, standoff_m, &p)) {
+    out.measured = false;
+    out.note = "stripe end ray does not meet the board plane";
+    return out;
+  }
+  out.error_m = p.head<2>();
+  GripperTwist t = GripperTwist::Zero();
+  t(0) = p_.gain * p.x();
+  t(1) = p_.gain * p.y();
+  out.twist = saturate_twist(t, p_.max_linear_speed, 1.0);
+  const bool ok = std::abs(p.x()) <= p_.converged_x_m && std::abs(p.y()) <= p_.converged_y_m;
+  in_tolerance_ = ok ? in_tolerance_ + 1 : 0;
+  out.converged = in_tolerance_ >= p_.converged_frames;
+  out.note = "tracking the stripe end";
+  return out;
+}
+
+}  // namespace bookgrasp

@@ -1,0 +1,118 @@
+// PBVS along the stripe against a plant with a book row hiding the stripe:
+// from station A left of the books it must pass the books, ignore the end of
+// the stripe segment left of them (and the side panel), and converge with the
+// TCP straight in front of the TRUE end (the right-most book's right edge).
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "servo_plant.h"
+#include "services/visual_servo/stripe_end_servo.h"
+
+namespace bookgrasp {
+namespace {
+
+StripeEndServoParams params() {
+  StripeEndServoParams p;
+  p.gain = 1.2;
+  p.max_linear_speed = 0.06;
+  p.search_speed = 0.1;
+  p.search_direction = +1;
+  p.require_occlusion = true;
+  p.converged_x_m = 0.0015;
+  p.converged_y_m = 0.0015;
+  p.converged_frames = 3;
+  p.max_search_distance_m = 1.0;
+  return p;
+}
+
+struct RunResult {
+  bool converged = false, failed = false;
+  int iterations = 0;
+  Eigen::Isometry3d tcp = Eigen::Isometry3d::Identity();
+};
+
+RunResult run(const test::StripeScene& scene, Eigen::Isometry3d tcp, double standoff, const StripeEndServoParams& p) {
+  const HandEyeGeometry g = test::project_geometry();
+  StripeEndServo servo(g, p);
+  const Eigen::Vector3d start = tcp.translation();
+  GripperTwist pending = GripperTwist::Zero();
+  RunResult r;
+  for (int i = 0; i < 1500; ++i) {
+    const StripeServoStep s = servo.step(scene.observe(g, tcp), standoff, (tcp.translation() - start).norm());
+    r.iterations = i + 1;
+    if (s.converged || s.failed) {
+      r.converged = s.converged;
+      r.failed = s.failed;
+      break;
+    }
+    tcp = test::integrate(tcp, pending, 1.0 / 30);
+    pending = s.twist;
+  }
+  r.tcp = tcp;
+  return r;
+}
+
+TEST(StripeEndServo, FromStationAPastTheBooksToTheTrueEnd) {
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> right(-0.05, 0.30), width(0.08, 0.45), off(-0.03, 0.03), depth(0.12, 0.2);
+  for (int trial = 0; trial < 30; ++trial) {
+    test::StripeScene scene;
+    scene.books_right = right(rng);
+    scene.books_left = std::max(scene.panel_left + 0.02, scene.books_right - width(rng));
+    scene.books_z = scene.board_z - 0.36 - depth(rng) * 0.1;
+    const double standoff = scene.board_z;  // TCP at W z = 0
+    Eigen::Isometry3d a = Eigen::Isometry3d::Identity();
+    a.translation() = Eigen::Vector3d(scene.stripe_x + off(rng), -0.32, 0.0);  // station A, left of the books
+    const RunResult r = run(scene, a, standoff, params());
+    ASSERT_TRUE(r.converged) << "trial " << trial << " books [" << scene.books_left << ", " << scene.books_right << "]";
+    EXPECT_NEAR(r.tcp.translation().y(), scene.books_right, 1.5e-3) << trial;  // PS.y = the true end
+    EXPECT_NEAR(r.tcp.translation().x(), scene.stripe_x, 1.5e-3) << trial;     // PS.x = stripe height
+    EXPECT_NEAR(r.tcp.translation().z(), 0.0, 1e-9) << trial;                  // fixed depth
+  }
+}
+
+TEST(StripeEndServo, StartingRightOfTheEndSearchingLeft) {
+  test::StripeScene scene;
+  StripeEndServoParams p = params();
+  p.search_direction = -1;
+  p.require_occlusion = false;
+  Eigen::Isometry3d a = Eigen::Isometry3d::Identity();
+  a.translation() = Eigen::Vector3d(0.01, 0.38, 0.0);
+  const RunResult r = run(scene, a, scene.board_z, p);
+  ASSERT_TRUE(r.converged);
+  EXPECT_NEAR(r.tcp.translation().y(), scene.books_right, 1.5e-3);
+}
+
+TEST(StripeEndServo, GivesUpAfterTheMaximumSearchDistance) {
+  test::StripeScene scene;
+  scene.books_left = -0.4;
+  scene.books_right = 0.4;  // books everywhere: the stripe is never seen
+  StripeEndServoParams p = params();
+  p.max_search_distance_m = 0.3;
+  const RunResult r = run(scene, Eigen::Isometry3d::Identity(), scene.board_z, p);
+  EXPECT_TRUE(r.failed);
+  EXPECT_FALSE(r.converged);
+  EXPECT_NEAR(r.tcp.translation().y(), 0.3, 0.02);
+}
+
+TEST(StripeEndServo, AnEndBeforeTheOcclusionIsNotAccepted) {
+  const HandEyeGeometry g = test::project_geometry();
+  StripeEndServo servo(g, params());
+  StripeObservation o;  // a stripe across the target column with its left end inside: the panel end
+  o.found = o.end_found = true;
+  o.end_px = {100, 300};
+  o.line_start_px = {100, 300};
+  o.line_end_px = {639, 300};
+  StripeServoStep s = servo.step(o, 0.5, 0.0);
+  EXPECT_EQ(s.phase, StripePhase::kSearch);
+  EXPECT_GT(s.twist(1), 0.0);
+  o.end_px = o.line_start_px = {500, 300};  // now the target column is hidden, end right of it
+  s = servo.step(o, 0.5, 0.05);
+  EXPECT_EQ(s.phase, StripePhase::kTrack);
+  EXPECT_TRUE(servo.occlusion_seen());
+  EXPECT_GT(s.error_px.x(), 0.0);
+}
+
+}  // namespace
+}  // namespace bookgrasp
