@@ -1,0 +1,139 @@
+#include "services/coordinator/cycle_geometry.h"
+
+#include <cmath>
+#include <stdexcept>
+
+#include "common/grasp_frame.h"
+
+namespace bookgrasp {
+namespace {
+
+Eigen::Vector3d vec3(const Config& c, const std::string& key, double limit = 5.0) {
+  const std::vector<double> v = c.get_vector(key, 3);
+  const Eigen::Vector3d e(v[0], v[1], v[2]);
+  if (!e.allFinite() || e.norm() > limit)
+    throw ConfigError(c.source() + ": " + c.path_of(key) + " must be finite and within " + std::to_string(limit) + " m");
+  return e;
+}
+
+}  // namespace
+
+CycleGeometry CycleGeometry::from_config(const Config& c) {
+  CycleGeometry g;
+  g.grasp_origin_in_marker = vec3(c, "cart.grasp_origin_in_marker_m");
+  g.shelf_left_y = c.get_double("cart.shelf_left_y_m", -3, 3);
+  g.shelf_right_y = c.get_double("cart.shelf_right_y_m", -3, 3);
+  if (g.shelf_right_y <= g.shelf_left_y)
+    throw ConfigError(c.source() + ": " + c.path_of("cart.shelf_right_y_m") + " must be right of (greater than) " +
+                      c.path_of("cart.shelf_left_y_m"));
+  g.stripe_start = vec3(c, "servo.stripe_start_grasp_m");
+  g.stripe_fixed_depth = c.get_double("servo.stripe_fixed_depth_m", 0.02, 1.0);
+  g.bwh_start_z = c.get_double("servo.bwh_start_z_m", -1.0, 0.0);
+  g.bwh_start_offset_x = c.get_double("servo.bwh_start_offset_x_m", -0.3, 0.3);
+  g.grasp_offset_x = c.get_double("grasp.offset_x_m", -0.1, 0.1);
+  g.grasp_offset_y = c.get_double("grasp.offset_y_m", -0.1, 0.1);
+  g.insertion_depth = c.get_double("grasp.insertion_depth_m", 0.0, 0.2);
+  g.pre_grasp_distance = c.get_double("grasp.pre_grasp_distance_m", 0.01, 0.5);
+  g.extract_lift = c.get_double("grasp.extract_lift_m", 0.0, 0.1);
+  g.extract_retreat = c.get_double("grasp.extract_retreat_m", 0.05, 1.0);
+  g.holder_support_in_marker = vec3(c, "holder.support_origin_in_marker_m");
+  g.holder_place_tcp = vec3(c, "holder.place_tcp_in_support_m");
+  const Eigen::Vector3d x = vec3(c, "holder.gripper_x_in_support"), y = vec3(c, "holder.gripper_y_in_support");
+  if (std::abs(x.norm() - 1) > 1e-6 || std::abs(y.norm() - 1) > 1e-6 || std::abs(x.dot(y)) > 1e-6)
+    throw ConfigError(c.source() + ": " + c.path_of("holder.gripper_x_in_support") + " and " +
+                      c.path_of("holder.gripper_y_in_support") + " must be orthogonal unit vectors");
+  g.holder_gripper_axes.col(0) = x;
+  g.holder_gripper_axes.col(1) = y;
+  g.holder_gripper_axes.col(2) = x.cross(y);
+  g.holder_pre_place_offset = vec3(c, "holder.pre_place_offset_m", 1.0);
+  g.holder_retreat = c.get_double("holder.retreat_m", 0.02, 0.6);
+  g.lower_drop = c.get_double("lower_shelf.drop_m", 0.1, 1.5);
+  g.lower_front_z = c.get_double("lower_shelf.front_z_m", -0.2, 0.5);
+  g.lower_first_right_y = c.get_double("lower_shelf.first_right_y_m", -3, 3);
+  g.lower_gap = c.get_double("lower_shelf.gap_m", 0.0, 0.1);
+  g.lower_left_y = c.get_double("lower_shelf.left_y_m", -3, 3);
+  if (g.lower_first_right_y <= g.lower_left_y)
+    throw ConfigError(c.source() + ": " + c.path_of("lower_shelf.first_right_y_m") + " must be right of " +
+                      c.path_of("lower_shelf.left_y_m"));
+  g.lower_pre_place_offset = vec3(c, "lower_shelf.pre_place_offset_m", 1.0);
+  g.lower_retreat = c.get_double("lower_shelf.retreat_m", 0.02, 1.0);
+  g.place_clearance = c.get_double("place_clearance_m", 0.0, 0.05);
+  return g;
+}
+
+Eigen::Isometry3d cart_grasp_frame(const Eigen::Isometry3d& m, const CycleGeometry& g) {
+  // AprilTag z points into the tag, i.e. into the rear board = into the shelf.
+  Eigen::Isometry3d f = grasp_frame_in_base(m.linear().col(2), Eigen::Vector3d::Zero());
+  f.translation() = m.translation() + f.linear() * g.grasp_origin_in_marker;
+  return f;
+}
+
+Eigen::Isometry3d holder_support_frame(const Eigen::Isometry3d& m, const CycleGeometry& g) {
+  Eigen::Isometry3d s = Eigen::Isometry3d::Identity();
+  s.linear().col(0) = m.linear().col(2);    // into the back plate
+  s.linear().col(1) = -m.linear().col(0);   // left along the plate (tag x is right)
+  s.linear().col(2) = -m.linear().col(1);   // up along the plate (tag y is down)
+  s.translation() = m * g.holder_support_in_marker;
+  return s;
+}
+
+Eigen::Isometry3d pose_in_grasp_frame(const Eigen::Isometry3d& f, const Eigen::Vector3d& p) {
+  Eigen::Isometry3d t = f;
+  t.translation() = f * p;
+  return t;
+}
+
+Eigen::Isometry3d stripe_start_pose(const Eigen::Isometry3d& f, const CycleGeometry& g) {
+  return pose_in_grasp_frame(f, g.stripe_start);
+}
+
+Eigen::Isometry3d bwh_start_pose(const Eigen::Isometry3d& f, const Eigen::Vector3d& start, const CycleGeometry& g) {
+  return pose_in_grasp_frame(f, Eigen::Vector3d(start.x() + g.bwh_start_offset_x, start.y(), g.bwh_start_z));
+}
+
+Eigen::Isometry3d move_along_own_axes(const Eigen::Isometry3d& pose, const Eigen::Vector3d& d) {
+  Eigen::Isometry3d t = pose;
+  t.translation() += pose.linear() * d;
+  return t;
+}
+
+Eigen::Isometry3d grasp_pose(const Eigen::Isometry3d& gp, const CycleGeometry& g) {
+  return move_along_own_axes(gp, Eigen::Vector3d(g.grasp_offset_x, g.grasp_offset_y, g.insertion_depth));
+}
+
+Eigen::Isometry3d pre_grasp_pose(const Eigen::Isometry3d& gp, const CycleGeometry& g) {
+  return move_along_own_axes(gp, Eigen::Vector3d(g.grasp_offset_x, g.grasp_offset_y, -g.pre_grasp_distance));
+}
+
+double tcp_height_on_book(const Eigen::Vector3d& gp_grasp, const CycleGeometry& g) {
+  return gp_grasp.x() + g.grasp_offset_x;
+}
+
+Eigen::Isometry3d holder_place_pose(const Eigen::Isometry3d& s, double h, const CycleGeometry& g) {
+  Eigen::Isometry3d local = Eigen::Isometry3d::Identity();
+  local.linear() = g.holder_gripper_axes;
+  local.translation() = g.holder_place_tcp + Eigen::Vector3d(0, 0, h + g.place_clearance);
+  return s * local;
+}
+
+Eigen::Isometry3d holder_pre_place_pose(const Eigen::Isometry3d& s, double h, const CycleGeometry& g) {
+  Eigen::Isometry3d p = holder_place_pose(s, h, g);
+  p.translation() += s.linear() * g.holder_pre_place_offset;
+  return p;
+}
+
+Eigen::Isometry3d lower_place_pose(const Eigen::Isometry3d& f, double right_y, double bw, double h,
+                                   const CycleGeometry& g) {
+  // The closed plates centre the book on the TCP: its right cover is BW/2 right of the TCP.
+  return pose_in_grasp_frame(
+      f, Eigen::Vector3d(-g.lower_drop + h + g.place_clearance, right_y - bw / 2, g.lower_front_z + g.insertion_depth));
+}
+
+Eigen::Isometry3d lower_pre_place_pose(const Eigen::Isometry3d& f, double right_y, double bw, double h,
+                                       const CycleGeometry& g) {
+  Eigen::Isometry3d p = lower_place_pose(f, right_y, bw, h, g);
+  p.translation() += f.linear() * g.lower_pre_place_offset;
+  return p;
+}
+
+}  // namespace bookgrasp

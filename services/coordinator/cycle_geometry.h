@@ -1,0 +1,89 @@
+#pragma once
+/// @file
+/// Where the library cycle moves the gripper: the cart's grasp frame and the
+/// holder's support frame from the markers, and every approach, grasp,
+/// extraction and placement pose from configured geometry. Pure functions, no LCM.
+///
+/// Frames: `grasp` (cart) = origin at the upper shelf's front edge centre, X up,
+/// Y right as seen from the robot, Z into the shelf; the same definition as the
+/// arbiter's (config/services/arbiter.yaml `cart.grasp_origin_in_marker_m`).
+/// Holder `support` frame = bottom front edge of the holder's back plate, x into
+/// the back plate, y left along it, z up along it. Marker poses follow the
+/// AprilTag convention of MARKERS (x right, y down, z into the tag).
+
+#include <Eigen/Geometry>
+
+#include "common/config.h"
+
+namespace bookgrasp {
+
+/// Geometry of the cycle, all from configuration (metres).
+struct CycleGeometry {
+  // cart
+  Eigen::Vector3d grasp_origin_in_marker = Eigen::Vector3d::Zero();  ///< grasp origin from the cart marker, grasp axes
+  double shelf_left_y = -0.40;   ///< inner left end of the upper shelf, grasp Y
+  double shelf_right_y = 0.40;   ///< inner right end, grasp Y
+  // BSwH and BwH servo starts
+  Eigen::Vector3d stripe_start = Eigen::Vector3d::Zero();  ///< position A (grasp frame)
+  double stripe_fixed_depth = 0.2;  ///< distance kept to the rear board during the stripe servo
+  double bwh_start_z = -0.15;       ///< fixed Z in front of the cart where BwH starts
+  double bwh_start_offset_x = 0.0;  ///< added to the start point's X
+  // grasp
+  double grasp_offset_x = 0.0;      ///< TCP below (-) / above (+) GP along X
+  double grasp_offset_y = 0.0;      ///< TCP right (+) of GP along Y
+  double insertion_depth = 0.02;    ///< TCP this far beyond GP along Z
+  double pre_grasp_distance = 0.10; ///< pre-grasp pose this far in front of GP along -Z
+  double extract_lift = 0.01;       ///< first lift along the gripper x after the grasp
+  double extract_retreat = 0.40;    ///< then straight out along the gripper -z
+  // holder
+  Eigen::Vector3d holder_support_in_marker = Eigen::Vector3d::Zero();  ///< support origin, holder marker axes
+  Eigen::Vector3d holder_place_tcp = Eigen::Vector3d::Zero();  ///< TCP in support; z gets the book height added
+  Eigen::Matrix3d holder_gripper_axes = Eigen::Matrix3d::Identity();  ///< gripper axes in support (columns)
+  Eigen::Vector3d holder_pre_place_offset = Eigen::Vector3d::Zero();  ///< pre-place = place + this (support)
+  double holder_retreat = 0.10;     ///< after release, out along the gripper -z
+  // lower shelf
+  double lower_drop = 0.35;         ///< lower shelf surface below the upper one
+  double lower_front_z = 0.01;      ///< fore-edges' plane on the lower shelf, grasp Z
+  double lower_first_right_y = 0.38;///< right cover of the first book placed, grasp Y
+  double lower_gap = 0.003;         ///< between books placed on the lower shelf
+  double lower_left_y = -0.40;      ///< inner left end of the lower shelf, grasp Y
+  Eigen::Vector3d lower_pre_place_offset = Eigen::Vector3d::Zero();  ///< pre-place = place + this (grasp)
+  double lower_retreat = 0.30;      ///< after release, out along -Z
+  double place_clearance = 0.005;   ///< book bottom this far above a support when released
+
+  /// Reads the `geometry:` section; throws ConfigError naming a bad key.
+  static CycleGeometry from_config(const Config& geometry);
+};
+
+/// The cart's grasp frame in base from the cart marker's pose in base.
+Eigen::Isometry3d cart_grasp_frame(const Eigen::Isometry3d& cart_marker_in_base, const CycleGeometry& g);
+/// The holder's support frame in base from the holder marker's pose in base.
+Eigen::Isometry3d holder_support_frame(const Eigen::Isometry3d& holder_marker_in_base, const CycleGeometry& g);
+
+/// A pose with the grasp frame's orientation at grasp-frame point `p`.
+Eigen::Isometry3d pose_in_grasp_frame(const Eigen::Isometry3d& grasp_frame, const Eigen::Vector3d& p);
+/// Gripper pose at the stripe servo's start A.
+Eigen::Isometry3d stripe_start_pose(const Eigen::Isometry3d& grasp_frame, const CycleGeometry& g);
+/// Gripper pose where BwH servoing starts, for the start point `start_grasp` (P1 or PS, grasp frame).
+Eigen::Isometry3d bwh_start_pose(const Eigen::Isometry3d& grasp_frame, const Eigen::Vector3d& start_grasp,
+                                 const CycleGeometry& g);
+/// TCP pose that grasps the book: GP's gripper pose shifted by the offsets and the insertion depth.
+Eigen::Isometry3d grasp_pose(const Eigen::Isometry3d& gp_base, const CycleGeometry& g);
+/// Pre-grasp pose: the grasp pose moved back along its z to `pre_grasp_distance` in front of GP.
+Eigen::Isometry3d pre_grasp_pose(const Eigen::Isometry3d& gp_base, const CycleGeometry& g);
+/// Book height above its support at the TCP: GP.x (top above the upper shelf) plus the X offset.
+double tcp_height_on_book(const Eigen::Vector3d& gp_grasp, const CycleGeometry& g);
+/// TCP pose that puts the held book on the holder's ledge.
+Eigen::Isometry3d holder_place_pose(const Eigen::Isometry3d& support, double tcp_height, const CycleGeometry& g);
+/// Pre-place pose on the holder.
+Eigen::Isometry3d holder_pre_place_pose(const Eigen::Isometry3d& support, double tcp_height, const CycleGeometry& g);
+/// TCP pose that stands the held book on the lower shelf with its right cover at grasp Y `right_y`.
+Eigen::Isometry3d lower_place_pose(const Eigen::Isometry3d& grasp_frame, double right_y, double book_width,
+                                   double tcp_height, const CycleGeometry& g);
+/// Pre-place pose on the lower shelf.
+Eigen::Isometry3d lower_pre_place_pose(const Eigen::Isometry3d& grasp_frame, double right_y, double book_width,
+                                       double tcp_height, const CycleGeometry& g);
+/// `pose` moved by `d` along its own axes (x, y, z).
+Eigen::Isometry3d move_along_own_axes(const Eigen::Isometry3d& pose, const Eigen::Vector3d& d);
+
+}  // namespace bookgrasp

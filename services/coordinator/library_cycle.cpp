@@ -1,0 +1,864 @@
+#include "services/coordinator/library_cycle.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <initializer_list>
+
+namespace bookgrasp {
+namespace {
+
+constexpr int kArmIdle = 0;
+constexpr int kArmStopped = 2;
+constexpr int kArmFault = 3;
+constexpr int kServoBookCorner = 1;
+constexpr int kServoStripeEnd = 2;
+constexpr int kServoConverged = 2;
+constexpr int kServoRunning = 1;
+constexpr int kServoIdle = 0;
+
+std::string mm(double m) {
+  char buf[32];
+  std::snprintf(buf, sizeof(buf), "%.1f mm", m * 1000);
+  return buf;
+}
+
+std::string servo_state_name(int s) {
+  switch (s) {
+    case 0: return "IDLE";
+    case 1: return "RUNNING";
+    case 2: return "CONVERGED";
+    case 3: return "FEATURE_LOST";
+    case 4: return "TIMEOUT";
+    case 5: return "FAILED";
+    case 6: return "CANCELLED";
+  }
+  return "state " + std::to_string(s);
+}
+
+CycleRequest make_request(CycleRequest::Kind k) {
+  CycleRequest r;
+  r.kind = k;
+  return r;
+}
+
+bool in(CycleState s, std::initializer_list<CycleState> set) {
+  return std::find(set.begin(), set.end(), s) != set.end();
+}
+
+}  // namespace
+
+std::string cycle_state_name(CycleState s) {
+  switch (s) {
+    case CycleState::kStart: return "START";
+    case CycleState::kWaitMarkers: return "WAIT_MARKERS";
+    case CycleState::kBackOut: return "BACK_OUT";
+    case CycleState::kPark: return "PARK";
+    case CycleState::kWaitP1Check: return "WAIT_P1_CHECK";
+    case CycleState::kMoveToStripeStart: return "MOVE_TO_STRIPE_START";
+    case CycleState::kServoStripe: return "SERVO_STRIPE";
+    case CycleState::kWaitPsCheck: return "WAIT_PS_CHECK";
+    case CycleState::kMoveToBwhStart: return "MOVE_TO_BWH_START";
+    case CycleState::kServoBook: return "SERVO_BOOK";
+    case CycleState::kWaitDecision: return "WAIT_DECISION";
+    case CycleState::kMoveToPreGrasp: return "MOVE_TO_PRE_GRASP";
+    case CycleState::kOpenForGrasp: return "OPEN_FOR_GRASP";
+    case CycleState::kInsert: return "INSERT";
+    case CycleState::kCloseGripper: return "CLOSE_GRIPPER";
+    case CycleState::kExtract: return "EXTRACT";
+    case CycleState::kMoveToHolder: return "MOVE_TO_HOLDER";
+    case CycleState::kPlaceOnHolder: return "PLACE_ON_HOLDER";
+    case CycleState::kReleaseOnHolder: return "RELEASE_ON_HOLDER";
+    case CycleState::kRetreatFromHolder: return "RETREAT_FROM_HOLDER";
+    case CycleState::kParkForUser: return "PARK_FOR_USER";
+    case CycleState::kWaitUser: return "WAIT_USER";
+    case CycleState::kMoveToHolderPreGrasp: return "MOVE_TO_HOLDER_PRE_GRASP";
+    case CycleState::kOpenForHolderGrasp: return "OPEN_FOR_HOLDER_GRASP";
+    case CycleState::kApproachHolder: return "APPROACH_HOLDER";
+    case CycleState::kGraspFromHolder: return "GRASP_FROM_HOLDER";
+    case CycleState::kLiftFromHolder: return "LIFT_FROM_HOLDER";
+    case CycleState::kMoveToLowerShelf: return "MOVE_TO_LOWER_SHELF";
+    case CycleState::kPlaceOnLowerShelf: return "PLACE_ON_LOWER_SHELF";
+    case CycleState::kReleaseOnLowerShelf: return "RELEASE_ON_LOWER_SHELF";
+    case CycleState::kRetreatFromLowerShelf: return "RETREAT_FROM_LOWER_SHELF";
+    case CycleState::kDone: return "DONE";
+    case CycleState::kAborted: return "ABORTED";
+  }
+  return "?";
+}
+
+namespace {
+CycleState state_from_name(const std::string& n) {
+  for (int i = 0; i <= static_cast<int>(CycleState::kAborted); ++i)
+    if (cycle_state_name(static_cast<CycleState>(i)) == n) return static_cast<CycleState>(i);
+  return CycleState::kStart;
+}
+}  // namespace
+
+CycleSettings CycleSettings::from_config(const Config& root) {
+  CycleSettings s;
+  s.geometry = CycleGeometry::from_config(root.child("geometry"));
+  s.park_joints = root.get_vector("park_joints_deg", 7);
+  for (double& q : s.park_joints) q *= M_PI / 180.0;
+  const Config t = root.child("timeouts");
+  s.markers_timeout_s = t.get_double("markers_s", 0.1, 600);
+  s.decision_timeout_s = t.get_double("decision_s", 0.1, 600);
+  s.servo_timeout_s = t.get_double("servo_s", 0.1, 600);
+  s.plan_timeout_s = t.get_double("plan_s", 0.1, 600);
+  s.motion_margin_s = t.get_double("motion_margin_s", 0.1, 600);
+  s.gripper_timeout_s = t.get_double("gripper_s", 0.1, 600);
+  s.user_timeout_s = t.get_double("user_s", 0, 1e6);
+  s.auto_done_after_s = root.get_double("user.auto_done_after_s", 0, 1e6);
+  s.max_attempts_per_book = root.get_int("retries.max_attempts_per_book", 1, 100);
+  s.max_step_retries = root.get_int("retries.max_step_retries", 0, 100);
+  const Config p = root.child("planning");
+  s.planner = p.get<std::string>("planner");
+  s.plan_time_budget_s = p.get_double("time_budget_s", 0.01, 120);
+  s.plan_position_tolerance_m = p.get_double("position_tolerance_m", 1e-5, 0.1);
+  s.plan_orientation_tolerance_rad = p.get_double("orientation_tolerance_rad", 1e-5, 1.0);
+  s.held_book_depth_m = p.get_double("held_book_depth_m", 0.01, 1.0);
+  const Config a = root.child("arm");
+  s.heartbeat_period_s = a.get_double("heartbeat_period_s", 0.005, 0.1);
+  s.linear_max_speed = a.get_double("linear_max_speed_mps", 0.001, 0.15);
+  s.linear_max_angular_speed = a.get_double("linear_max_angular_speed_rps", 0.001, 0.6);
+  s.linear_gain = a.get_double("linear_gain", 0.1, 20);
+  s.linear_position_tolerance = a.get_double("linear_position_tolerance_m", 1e-5, 0.02);
+  s.linear_orientation_tolerance = a.get_double("linear_orientation_tolerance_rad", 1e-5, 0.2);
+  const Config g = root.child("gripper");
+  s.gripper_open_width = g.get_double("open_width_m", 0.005, 0.2);
+  s.gripper_open_tolerance = g.get_double("open_tolerance_m", 1e-5, 0.02);
+  s.gripper_speed = g.get_double("speed_mps", 0.001, 1.0);
+  s.gripper_force = g.get_double("force_n", 1, 500);
+  s.gripper_settle_s = g.get_double("settle_s", 0, 5);
+  s.gripper_settle_tolerance = g.get_double("settle_tolerance_m", 1e-6, 0.01);
+  s.min_book_width = g.get_double("min_book_width_m", 0.0, 0.05);
+  s.empty_stripe_margin = root.get_double("empty_shelf.stripe_margin_m", 0.0, 0.5);
+  s.s_min = root.get_double("empty_shelf.s_min_m", 0.0, 0.2);
+  return s;
+}
+
+LibraryCycle::LibraryCycle(CycleSettings settings, std::optional<TaskProgress> resume) : s_(std::move(settings)) {
+  if (resume) {
+    progress_ = *resume;
+    resume_from_ = state_from_name(progress_.last_state);
+  } else {
+    progress_.lower_next_right_y = s_.geometry.lower_first_right_y;
+  }
+  message_ = resume ? "resuming: book " + std::to_string(progress_.books_moved) + " is on/in the " +
+                          book_place_name(progress_.place) + " (was " + progress_.last_state + ")"
+                    : "starting";
+}
+
+bool LibraryCycle::take_progress_changed() {
+  const bool c = progress_changed_;
+  progress_changed_ = false;
+  return c;
+}
+
+bool LibraryCycle::take_status_changed() {
+  const bool c = status_changed_;
+  status_changed_ = false;
+  return c;
+}
+
+CycleStatus LibraryCycle::status() const {
+  CycleStatus st;
+  st.state = cycle_state_name(state_);
+  st.books_moved = progress_.books_moved;
+  st.current_book = progress_.books_moved;
+  const bool current = !progress_.finished && state_ != CycleState::kDone;
+  st.books_total = progress_.books_moved + (current ? 1 : 0);
+  st.attempt = attempt_;
+  st.failures = progress_.failures;
+  st.message = message_;
+  return st;
+}
+
+int64_t LibraryCycle::next_id() {
+  // Unique across restarts: ids never fall behind message time.
+  last_id_ = std::max(last_id_ + 1, now_);
+  return last_id_;
+}
+
+void LibraryCycle::persist() {
+  progress_.last_state = cycle_state_name(state_);
+  progress_changed_ = true;
+}
+
+Eigen::Isometry3d LibraryCycle::cart_frame() const { return cart_grasp_frame(*cart_marker_, s_.geometry); }
+Eigen::Isometry3d LibraryCycle::holder_frame() const { return holder_support_frame(*holder_marker_, s_.geometry); }
+double LibraryCycle::tcp_height() const { return tcp_height_on_book(progress_.gp_grasp, s_.geometry); }
+
+void LibraryCycle::advance_time(int64_t utime) {
+  if (utime > now_) now_ = utime;
+}
+
+void LibraryCycle::set_deadline(double seconds) {
+  deadline_ = seconds > 0 ? now_ + static_cast<int64_t>(seconds * 1e6) : -1;
+}
+
+void LibraryCycle::check_timeout() {
+  if (deadline_ < 0 || now_ < deadline_ || state_ == CycleState::kDone || state_ == CycleState::kAborted) return;
+  deadline_ = -1;
+  const std::string what = cycle_state_name(state_);
+  if (state_ == CycleState::kWaitMarkers) {
+    abort("timeout in WAIT_MARKERS: cart and holder markers not both seen within " +
+          std::to_string(s_.markers_timeout_s) + " s (is marker_detector running, are the tags in view?)");
+    return;
+  }
+  if (state_ == CycleState::kWaitUser) {
+    abort("timeout in WAIT_USER: no \"done\" from the user within " + std::to_string(s_.user_timeout_s) + " s");
+    return;
+  }
+  if (motion_.kind == MotionKind::kPlanned && motion_.planning) {
+    fail("timeout in " + what + ": no PLAN_RESULT within " + std::to_string(s_.plan_timeout_s) + " s");
+  } else if (motion_.kind != MotionKind::kNone) {
+    if (motion_.executing || motion_.kind == MotionKind::kLinear) out_.push_back(make_request(CycleRequest::Kind::kArmStop));
+    fail("timeout in " + what + ": the motion did not finish in time");
+  } else {
+    fail("timeout in " + what);
+  }
+}
+
+// ---- motions ----
+
+void LibraryCycle::start_planned_joints(const std::vector<double>& goal) {
+  motion_ = Motion{};
+  motion_.kind = MotionKind::kPlanned;
+  motion_.joints_goal = true;
+  motion_.goal_joints = goal;
+  issue_plan();
+}
+
+void LibraryCycle::start_planned_pose(const Eigen::Isometry3d& goal, bool holding) {
+  motion_ = Motion{};
+  motion_.kind = MotionKind::kPlanned;
+  motion_.goal = goal;
+  motion_.holding = holding;
+  issue_plan();
+}
+
+void LibraryCycle::issue_plan() {
+  motion_.planning = true;
+  set_deadline(s_.plan_timeout_s);
+  if (!arm_) return;  // issued at the first arm state
+  CycleRequest r;
+  r.kind = CycleRequest::Kind::kPlan;
+  r.id = next_id();
+  motion_.plan_id = r.id;
+  r.joints_goal = motion_.joints_goal;
+  r.goal_joints = motion_.goal_joints;
+  r.pose = motion_.goal;
+  r.start_joints = arm_->joints;
+  r.holding_book = motion_.holding;
+  if (motion_.holding)
+    r.book_size = Eigen::Vector3d(progress_.book_width, std::max(0.0, progress_.gp_grasp.x()), s_.held_book_depth_m);
+  out_.push_back(r);
+}
+
+void LibraryCycle::start_linear(std::vector<Eigen::Isometry3d> waypoints) {
+  motion_ = Motion{};
+  motion_.kind = MotionKind::kLinear;
+  motion_.waypoints = std::move(waypoints);
+  motion_.command_id = next_id();
+  double length = 0;
+  Eigen::Vector3d from = arm_ ? arm_->end_effector.translation() : motion_.waypoints.front().translation();
+  for (const auto& w : motion_.waypoints) {
+    length += (w.translation() - from).norm();
+    from = w.translation();
+  }
+  set_deadline(length / s_.linear_max_speed + s_.motion_margin_s);
+}
+
+void LibraryCycle::start_gripper(bool grasp) {
+  motion_ = Motion{};
+  motion_.kind = grasp ? MotionKind::kGripperGrasp : MotionKind::kGripperOpen;
+  CycleRequest r;
+  r.kind = grasp ? CycleRequest::Kind::kGripperGrasp : CycleRequest::Kind::kGripperMove;
+  r.id = next_id();
+  r.width = grasp ? 0.0 : s_.gripper_open_width;
+  r.force = s_.gripper_force;
+  r.speed = s_.gripper_speed;
+  out_.push_back(r);
+  set_deadline(s_.gripper_timeout_s);
+}
+
+void LibraryCycle::drive_motion(const ArmEvent& e) {
+  switch (motion_.kind) {
+    case MotionKind::kNone: return;
+    case MotionKind::kPlanned: {
+      if (motion_.planning && motion_.plan_id < 0) {
+        issue_plan();
+        return;
+      }
+      if (!motion_.executing) return;
+      if (e.active_command_id == motion_.command_id) {
+        if (e.state == kArmIdle) {
+          motion_done();
+          return;
+        }
+        if (e.state == kArmStopped || e.state == kArmFault) {
+          fail("the arm stopped during " + cycle_state_name(state_) + ": " + e.message);
+          return;
+        }
+      }
+      if (static_cast<double>(now_ - last_command_utime_) >= s_.heartbeat_period_s * 1e6) {
+        CycleRequest hb;
+        hb.kind = CycleRequest::Kind::kHeartbeat;
+        hb.id = motion_.command_id;
+        out_.push_back(hb);
+        last_command_utime_ = now_;
+      }
+      return;
+    }
+    case MotionKind::kLinear: {
+      if (e.active_command_id == motion_.command_id && (e.state == kArmStopped || e.state == kArmFault) &&
+          motion_.executing) {
+        fail("the arm stopped during the straight move of " + cycle_state_name(state_) + ": " + e.message);
+        return;
+      }
+      const Eigen::Isometry3d& target = motion_.waypoints[motion_.waypoint];
+      const Eigen::Vector3d ep = target.translation() - e.end_effector.translation();
+      const Eigen::AngleAxisd er(target.linear() * e.end_effector.linear().transpose());
+      if (ep.norm() < s_.linear_position_tolerance && std::abs(er.angle()) < s_.linear_orientation_tolerance) {
+        if (++motion_.waypoint >= motion_.waypoints.size()) {
+          out_.push_back(make_request(CycleRequest::Kind::kArmStop));
+          motion_done();
+        }
+        return;
+      }
+      if (motion_.executing && static_cast<double>(now_ - last_command_utime_) < s_.heartbeat_period_s * 1e6) return;
+      Eigen::Vector3d v = s_.linear_gain * ep;
+      if (v.norm() > s_.linear_max_speed) v *= s_.linear_max_speed / v.norm();
+      Eigen::Vector3d w = s_.linear_gain * er.angle() * er.axis();
+      if (w.norm() > s_.linear_max_angular_speed) w *= s_.linear_max_angular_speed / w.norm();
+      CycleRequest r;
+      r.kind = CycleRequest::Kind::kTwist;
+      r.id = motion_.command_id;
+      r.twist << v, w;
+      out_.push_back(r);
+      motion_.executing = true;
+      last_command_utime_ = now_;
+      return;
+    }
+    case MotionKind::kGripperOpen:
+    case MotionKind::kGripperGrasp: {
+      const double w = e.gripper_width;
+      if (motion_.settle_start < 0 || std::abs(w - motion_.settle_width) > s_.gripper_settle_tolerance) {
+        motion_.settle_start = now_;
+        motion_.settle_width = w;
+      }
+      const bool settled = static_cast<double>(now_ - motion_.settle_start) >= s_.gripper_settle_s * 1e6;
+      if (!settled) return;
+      if (motion_.kind == MotionKind::kGripperOpen) {
+        if (w >= s_.gripper_open_width - s_.gripper_open_tolerance) motion_done();
+        return;
+      }
+      if (e.gripper_contact || w < s_.min_book_width) handle_gripper_result(w, e.gripper_contact);
+      return;
+    }
+  }
+}
+
+void LibraryCycle::handle_gripper_result(double width, bool contact) {
+  if (!contact || width < s_.min_book_width) {
+    fail("nothing grasped in " + cycle_state_name(state_) + ": the gripper closed to " + mm(width) +
+         (contact ? "" : " without contact"));
+    return;
+  }
+  if (state_ == CycleState::kCloseGripper) {
+    progress_.place = BookPlace::kInGripperFromShelf;
+    progress_.have_book_data = true;
+    progress_.book_width = width;
+    message_ = "book " + std::to_string(progress_.books_moved) + " grasped, width " + mm(width);
+  } else {
+    progress_.place = BookPlace::kInGripperFromHolder;
+    message_ = "book " + std::to_string(progress_.books_moved) + " taken from the holder";
+  }
+  motion_done();
+}
+
+void LibraryCycle::motion_done() {
+  motion_ = Motion{};
+  after_motion();
+}
+
+// What follows each state once its motion (or wait) finished.
+void LibraryCycle::after_motion() {
+  const CycleGeometry& g = s_.geometry;
+  switch (state_) {
+    case CycleState::kBackOut: succeed(CycleState::kPark); return;
+    case CycleState::kPark:
+      succeed(progress_.finished ? CycleState::kDone : CycleState::kWaitP1Check);
+      return;
+    case CycleState::kMoveToStripeStart: succeed(CycleState::kServoStripe); return;
+    case CycleState::kMoveToBwhStart: succeed(CycleState::kServoBook); return;
+    case CycleState::kMoveToPreGrasp: succeed(CycleState::kOpenForGrasp); return;
+    case CycleState::kOpenForGrasp: succeed(CycleState::kInsert); return;
+    case CycleState::kInsert: succeed(CycleState::kCloseGripper); return;
+    case CycleState::kCloseGripper: succeed(CycleState::kExtract); return;
+    case CycleState::kExtract: succeed(CycleState::kMoveToHolder); return;
+    case CycleState::kMoveToHolder: succeed(CycleState::kPlaceOnHolder); return;
+    case CycleState::kPlaceOnHolder: succeed(CycleState::kReleaseOnHolder); return;
+    case CycleState::kReleaseOnHolder:
+      progress_.place = BookPlace::kOnHolder;
+      message_ = "book " + std::to_string(progress_.books_moved) + " on the holder";
+      succeed(CycleState::kRetreatFromHolder);
+      return;
+    case CycleState::kRetreatFromHolder: succeed(CycleState::kParkForUser); return;
+    case CycleState::kParkForUser: succeed(CycleState::kWaitUser); return;
+    case CycleState::kMoveToHolderPreGrasp: succeed(CycleState::kOpenForHolderGrasp); return;
+    case CycleState::kOpenForHolderGrasp: succeed(CycleState::kApproachHolder); return;
+    case CycleState::kApproachHolder: succeed(CycleState::kGraspFromHolder); return;
+    case CycleState::kGraspFromHolder: succeed(CycleState::kLiftFromHolder); return;
+    case CycleState::kLiftFromHolder: succeed(CycleState::kMoveToLowerShelf); return;
+    case CycleState::kMoveToLowerShelf: succeed(CycleState::kPlaceOnLowerShelf); return;
+    case CycleState::kPlaceOnLowerShelf: succeed(CycleState::kReleaseOnLowerShelf); return;
+    case CycleState::kReleaseOnLowerShelf: {
+      MovedBook b;
+      b.index = progress_.books_moved;
+      b.width = progress_.book_width;
+      b.gp_y = progress_.gp_grasp.y();
+      b.lower_right_y = progress_.lower_next_right_y;
+      progress_.moved.push_back(b);
+      progress_.books_moved += 1;
+      progress_.lower_next_right_y -= progress_.book_width + g.lower_gap;
+      progress_.place = BookPlace::kUpperShelf;
+      progress_.have_book_data = false;
+      // Rule (a): the room left of this book, up to the shelf's left end, cannot hold an admissible book.
+      const double room = b.gp_y - b.width - g.shelf_left_y;
+      if (room < s_.s_min) {
+        progress_.finished = true;
+        message_ = "book " + std::to_string(b.index) + " on the lower shelf; upper shelf empty: " + mm(room) +
+                   " left of it < S_min " + mm(s_.s_min);
+      } else {
+        message_ = "book " + std::to_string(b.index) + " on the lower shelf";
+      }
+      attempt_ = 1;
+      succeed(CycleState::kRetreatFromLowerShelf);
+      return;
+    }
+    case CycleState::kRetreatFromLowerShelf: succeed(CycleState::kPark); return;
+    default: return;
+  }
+}
+
+// ---- transitions ----
+
+void LibraryCycle::succeed(CycleState next) {
+  step_retries_ = 0;
+  enter(next);
+}
+
+void LibraryCycle::enter(CycleState s) {
+  state_ = s;
+  entry_utime_ = now_;
+  deadline_ = -1;
+  motion_ = Motion{};
+  status_changed_ = true;
+  const CycleGeometry& g = s_.geometry;
+  switch (s) {
+    case CycleState::kStart:
+    case CycleState::kDone:
+    case CycleState::kAborted:
+      break;
+    case CycleState::kWaitMarkers:
+      set_deadline(s_.markers_timeout_s);
+      break;
+    case CycleState::kBackOut: {
+      out_.push_back(make_request(CycleRequest::Kind::kGripperMove));
+      out_.back().id = next_id();
+      out_.back().width = s_.gripper_open_width;
+      out_.back().force = s_.gripper_force;
+      out_.back().speed = s_.gripper_speed;
+      const Eigen::Isometry3d here = arm_->end_effector;
+      start_linear({move_along_own_axes(here, Eigen::Vector3d(0, 0, -(g.pre_grasp_distance + g.insertion_depth)))});
+      break;
+    }
+    case CycleState::kPark:
+    case CycleState::kParkForUser:
+      start_planned_joints(s_.park_joints);
+      break;
+    case CycleState::kWaitP1Check:
+      stripe_done_this_attempt_ = false;
+      early_decision_.reset();
+      set_deadline(s_.decision_timeout_s);
+      break;
+    case CycleState::kMoveToStripeStart:
+      start_planned_pose(stripe_start_pose(cart_frame(), g), false);
+      break;
+    case CycleState::kServoStripe: {
+      CycleRequest r;
+      r.kind = CycleRequest::Kind::kServo;
+      r.id = next_id();
+      stripe_request_ = r.id;
+      r.servo_mode = kServoStripeEnd;
+      r.pose = arm_ ? arm_->end_effector : stripe_start_pose(cart_frame(), g);
+      r.fixed_depth = g.stripe_fixed_depth;
+      r.timeout_s = s_.servo_timeout_s;
+      out_.push_back(r);
+      early_decision_.reset();
+      set_deadline(s_.servo_timeout_s + s_.decision_timeout_s);
+      break;
+    }
+    case CycleState::kWaitPsCheck:
+      stripe_done_this_attempt_ = true;
+      set_deadline(s_.decision_timeout_s);
+      if (early_decision_) {
+        const DecisionEvent d = *early_decision_;
+        early_decision_.reset();
+        handle_ps_check(d);
+      }
+      break;
+    case CycleState::kMoveToBwhStart:
+      start_planned_pose(bwh_start_pose(cart_frame(), bwh_start_, g), false);
+      break;
+    case CycleState::kServoBook: {
+      CycleRequest r;
+      r.kind = CycleRequest::Kind::kServo;
+      r.id = next_id();
+      servo_request_ = r.id;
+      r.servo_mode = kServoBookCorner;
+      r.pose = arm_ ? arm_->end_effector : bwh_start_pose(cart_frame(), bwh_start_, g);
+      r.rank = rank_;
+      r.timeout_s = s_.servo_timeout_s;
+      out_.push_back(r);
+      early_decision_.reset();
+      set_deadline(s_.servo_timeout_s + s_.decision_timeout_s);
+      break;
+    }
+    case CycleState::kWaitDecision:
+      set_deadline(s_.decision_timeout_s);
+      if (early_decision_) {
+        const DecisionEvent d = *early_decision_;
+        early_decision_.reset();
+        handle_grasp_decision(d);
+      }
+      break;
+    case CycleState::kMoveToPreGrasp:
+      start_planned_pose(pre_grasp_pose(gp_base_, g), false);
+      break;
+    case CycleState::kOpenForGrasp:
+    case CycleState::kOpenForHolderGrasp:
+    case CycleState::kReleaseOnHolder:
+    case CycleState::kReleaseOnLowerShelf:
+      start_gripper(false);
+      break;
+    case CycleState::kInsert:
+      start_linear({grasp_pose(gp_base_, g)});
+      break;
+    case CycleState::kCloseGripper:
+    case CycleState::kGraspFromHolder:
+      start_gripper(true);
+      break;
+    case CycleState::kExtract: {
+      const Eigen::Isometry3d here = arm_->end_effector;
+      const Eigen::Isometry3d lifted = move_along_own_axes(here, Eigen::Vector3d(g.extract_lift, 0, 0));
+      start_linear({lifted, move_along_own_axes(lifted, Eigen::Vector3d(0, 0, -g.extract_retreat))});
+      break;
+    }
+    case CycleState::kMoveToHolder:
+      start_planned_pose(holder_pre_place_pose(holder_frame(), tcp_height(), g), true);
+      break;
+    case CycleState::kPlaceOnHolder:
+    case CycleState::kApproachHolder:
+      start_linear({holder_place_pose(holder_frame(), tcp_height(), g)});
+      break;
+    case CycleState::kRetreatFromHolder:
+      start_linear({move_along_own_axes(arm_->end_effector, Eigen::Vector3d(0, 0, -g.holder_retreat))});
+      break;
+    case CycleState::kWaitUser:
+      user_event_sent_ = false;
+      set_deadline(s_.user_timeout_s);
+      message_ = "book " + std::to_string(progress_.books_moved) + " on the holder: waiting for the user's \"done\"";
+      break;
+    case CycleState::kMoveToHolderPreGrasp:
+      start_planned_pose(move_along_own_axes(holder_place_pose(holder_frame(), tcp_height(), g),
+                                             Eigen::Vector3d(0, 0, -g.holder_retreat)),
+                         false);
+      break;
+    case CycleState::kLiftFromHolder:
+      start_linear({holder_pre_place_pose(holder_frame(), tcp_height(), g)});
+      break;
+    case CycleState::kMoveToLowerShelf: {
+      const double left_after = progress_.lower_next_right_y - progress_.book_width;
+      if (left_after < g.lower_left_y) {
+        abort("the lower shelf is full: book " + std::to_string(progress_.books_moved) + " (" +
+              mm(progress_.book_width) + ") does not fit right of " + mm(g.lower_left_y) +
+              " (it stays in the gripper)");
+        return;
+      }
+      start_planned_pose(lower_pre_place_pose(cart_frame(), progress_.lower_next_right_y, progress_.book_width,
+                                              tcp_height(), g),
+                         true);
+      break;
+    }
+    case CycleState::kPlaceOnLowerShelf:
+      start_linear({lower_place_pose(cart_frame(), progress_.lower_next_right_y, progress_.book_width, tcp_height(), g)});
+      break;
+    case CycleState::kRetreatFromLowerShelf:
+      start_linear({move_along_own_axes(arm_->end_effector, Eigen::Vector3d(0, 0, -g.lower_retreat))});
+      break;
+  }
+  if (s == CycleState::kDone) {
+    progress_.finished = true;
+    message_ = "upper shelf empty: " + std::to_string(progress_.books_moved) + " books moved" +
+               (message_.empty() ? "" : " (" + message_ + ")");
+  }
+  persist();
+}
+
+void LibraryCycle::fail(const std::string& reason) {
+  progress_.failures += 1;
+  message_ = reason;
+  const bool before_grasp = in(state_, {CycleState::kWaitP1Check, CycleState::kMoveToStripeStart,
+                                        CycleState::kServoStripe, CycleState::kWaitPsCheck,
+                                        CycleState::kMoveToBwhStart, CycleState::kServoBook,
+                                        CycleState::kWaitDecision, CycleState::kMoveToPreGrasp,
+                                        CycleState::kOpenForGrasp, CycleState::kInsert, CycleState::kCloseGripper});
+  // A cancel also opens a new attempt in the arbiter (its P1 is no longer frozen).
+  if (before_grasp || in(state_, {CycleState::kServoStripe, CycleState::kServoBook, CycleState::kWaitDecision}))
+    out_.push_back(make_request(CycleRequest::Kind::kServoCancel));
+  if (before_grasp) {
+    if (attempt_ >= s_.max_attempts_per_book) {
+      abort("book " + std::to_string(progress_.books_moved) + ": " + std::to_string(attempt_) +
+            " attempts failed (retries.max_attempts_per_book), last: " + reason);
+      return;
+    }
+    attempt_ += 1;
+    message_ = "attempt " + std::to_string(attempt_) + " at book " + std::to_string(progress_.books_moved) +
+               " after: " + reason;
+    const bool inside = in(state_, {CycleState::kInsert, CycleState::kCloseGripper});
+    step_retries_ = 0;
+    enter(inside ? CycleState::kBackOut : CycleState::kPark);
+    return;
+  }
+  if (step_retries_ >= s_.max_step_retries) {
+    abort(cycle_state_name(state_) + " failed " + std::to_string(step_retries_ + 1) +
+          " times (retries.max_step_retries), last: " + reason + "; the book is on/in the " +
+          book_place_name(progress_.place));
+    return;
+  }
+  step_retries_ += 1;
+  message_ = "retry " + std::to_string(step_retries_) + " of " + cycle_state_name(state_) + " after: " + reason;
+  // A missed grasp on the holder: open and come back from the pre-grasp pose.
+  const CycleState again = state_ == CycleState::kGraspFromHolder ? CycleState::kMoveToHolderPreGrasp : state_;
+  enter(again);
+}
+
+void LibraryCycle::abort(const std::string& reason) {
+  out_.push_back(make_request(CycleRequest::Kind::kServoCancel));
+  out_.push_back(make_request(CycleRequest::Kind::kArmStop));
+  const std::string where = cycle_state_name(state_);
+  state_ = CycleState::kAborted;
+  deadline_ = -1;
+  motion_ = Motion{};
+  message_ = "aborted in " + where + ": " + reason;
+  status_changed_ = true;
+  progress_.last_state = where;  // resume from where it stopped
+  progress_changed_ = true;
+}
+
+CycleState LibraryCycle::resume_target() const {
+  if (progress_.finished) return CycleState::kDone;
+  const CycleState was = resume_from_;
+  switch (progress_.place) {
+    case BookPlace::kUpperShelf:
+      return in(was, {CycleState::kInsert, CycleState::kCloseGripper}) ? CycleState::kBackOut : CycleState::kPark;
+    case BookPlace::kInGripperFromShelf:
+      if (in(was, {CycleState::kCloseGripper, CycleState::kExtract})) return CycleState::kExtract;
+      if (in(was, {CycleState::kPlaceOnHolder})) return CycleState::kPlaceOnHolder;
+      return CycleState::kMoveToHolder;
+    case BookPlace::kOnHolder:
+      if (in(was, {CycleState::kRetreatFromHolder})) return CycleState::kRetreatFromHolder;
+      return CycleState::kParkForUser;
+    case BookPlace::kInGripperFromHolder:
+      if (in(was, {CycleState::kGraspFromHolder, CycleState::kLiftFromHolder})) return CycleState::kLiftFromHolder;
+      if (in(was, {CycleState::kPlaceOnLowerShelf})) return CycleState::kPlaceOnLowerShelf;
+      return CycleState::kMoveToLowerShelf;
+  }
+  return CycleState::kPark;
+}
+
+// ---- events ----
+
+std::vector<CycleRequest> LibraryCycle::on_arm(const ArmEvent& e) {
+  out_.clear();
+  advance_time(e.utime);
+  arm_ = e;
+  if (state_ == CycleState::kStart) {
+    out_.push_back(make_request(CycleRequest::Kind::kServoCancel));
+    out_.back().id = next_id();
+    enter(CycleState::kWaitMarkers);
+  }
+  if (state_ == CycleState::kWaitMarkers) {
+    if (cart_marker_ && holder_marker_) {
+      const bool holding = progress_.place == BookPlace::kInGripperFromShelf ||
+                           progress_.place == BookPlace::kInGripperFromHolder;
+      if (holding && !e.gripper_contact) {
+        abort("book " + std::to_string(progress_.books_moved) + " should be in the gripper (progress file: " +
+              book_place_name(progress_.place) + ") but the gripper reports no contact: find the book, correct "
+              "the progress file, restart");
+      } else {
+        succeed(resume_target());
+      }
+    }
+  } else if (state_ == CycleState::kWaitUser) {
+    if (s_.auto_done_after_s > 0 && !user_event_sent_ &&
+        static_cast<double>(now_ - entry_utime_) >= s_.auto_done_after_s * 1e6) {
+      CycleRequest r;
+      r.kind = CycleRequest::Kind::kUserEvent;
+      r.text = "done";
+      r.detail = "sent by the coordinator after user.auto_done_after_s (demo)";
+      out_.push_back(r);
+      user_event_sent_ = true;
+      message_ = "user \"done\" (automatic)";
+      succeed(CycleState::kMoveToHolderPreGrasp);
+    }
+  } else {
+    drive_motion(e);
+  }
+  check_timeout();
+  return out_;
+}
+
+std::vector<CycleRequest> LibraryCycle::on_markers(const MarkersEvent& e) {
+  out_.clear();
+  advance_time(e.utime);
+  if (e.cart) cart_marker_ = e.cart;
+  if (e.holder) holder_marker_ = e.holder;
+  check_timeout();
+  return out_;
+}
+
+void LibraryCycle::handle_p1_check(const DecisionEvent& d) {
+  if (d.outcome == "NEED_PS" || (!d.p1_present && !stripe_done_this_attempt_)) {
+    message_ = d.outcome == "NEED_PS" ? "no PS yet: BSwH to the stripe end"
+                                      : "BwS found no book: BSwH checks whether the stripe is free";
+    succeed(CycleState::kMoveToStripeStart);
+    return;
+  }
+  bwh_start_ = d.gp_grasp;
+  rank_ = 0;
+  message_ = d.reason;
+  succeed(CycleState::kMoveToBwhStart);
+}
+
+void LibraryCycle::handle_ps_check(const DecisionEvent& d) {
+  if (!d.ps_present) {
+    fail("the arbiter has no PS after the stripe servo converged: " + d.reason);
+    return;
+  }
+  const double from_left = d.ps_grasp.y() - s_.geometry.shelf_left_y;
+  if (from_left <= s_.empty_stripe_margin) {
+    message_ = "stripe end " + mm(from_left) + " from the shelf's left end: no book occludes the stripe";
+    progress_.finished = true;
+    succeed(CycleState::kPark);
+    return;
+  }
+  if (d.outcome != "P1_VALID" && d.outcome != "P1_INVALID") {
+    fail("unexpected arbiter answer after the stripe servo: " + d.reason);
+    return;
+  }
+  bwh_start_ = d.gp_grasp;
+  rank_ = 0;
+  message_ = d.reason;
+  succeed(CycleState::kMoveToBwhStart);
+}
+
+void LibraryCycle::handle_grasp_decision(const DecisionEvent& d) {
+  if (d.outcome == "GRASP" && d.valid) {
+    gp_base_ = d.gp_base;
+    progress_.gp_grasp = d.gp_grasp;
+    message_ = d.reason;
+    succeed(CycleState::kMoveToPreGrasp);
+  } else if (d.outcome == "NEXT_REGION") {
+    rank_ = d.next_rank;
+    message_ = d.reason;
+    succeed(CycleState::kMoveToBwhStart);
+  } else {
+    fail("arbiter: " + d.reason);
+  }
+}
+
+std::vector<CycleRequest> LibraryCycle::on_decision(const DecisionEvent& d) {
+  out_.clear();
+  advance_time(d.utime);
+  const bool check = d.outcome == "P1_VALID" || d.outcome == "P1_INVALID" || d.outcome == "NEED_PS";
+  switch (state_) {
+    case CycleState::kWaitP1Check:
+      if (check && d.utime >= entry_utime_ && d.request_id == 0) handle_p1_check(d);
+      break;
+    case CycleState::kServoStripe:
+      if (d.request_id == stripe_request_) early_decision_ = d;
+      break;
+    case CycleState::kWaitPsCheck:
+      if (d.request_id == stripe_request_) handle_ps_check(d);
+      break;
+    case CycleState::kServoBook:
+      if (d.request_id == servo_request_) early_decision_ = d;
+      break;
+    case CycleState::kWaitDecision:
+      if (d.request_id == servo_request_) handle_grasp_decision(d);
+      break;
+    default:
+      break;
+  }
+  check_timeout();
+  return out_;
+}
+
+std::vector<CycleRequest> LibraryCycle::on_servo(const ServoEvent& e) {
+  out_.clear();
+  advance_time(e.utime);
+  const bool terminal = e.state != kServoRunning && e.state != kServoIdle;
+  if (state_ == CycleState::kServoStripe && e.request_id == stripe_request_ && terminal) {
+    if (e.state == kServoConverged)
+      succeed(CycleState::kWaitPsCheck);
+    else
+      fail("stripe servo ended " + servo_state_name(e.state) + (e.message.empty() ? "" : ": " + e.message));
+  } else if (state_ == CycleState::kServoBook && e.request_id == servo_request_ && terminal) {
+    // Converged or not, the arbiter decides (a failed BwH servo is its NO_GRASP).
+    succeed(CycleState::kWaitDecision);
+  }
+  check_timeout();
+  return out_;
+}
+
+std::vector<CycleRequest> LibraryCycle::on_plan(const PlanEvent& e) {
+  out_.clear();
+  advance_time(e.utime);
+  if (motion_.kind == MotionKind::kPlanned && motion_.planning && e.request_id == motion_.plan_id) {
+    if (!e.success) {
+      fail("planning for " + cycle_state_name(state_) + " failed: " + e.message);
+    } else {
+      motion_.planning = false;
+      motion_.executing = true;
+      CycleRequest r;
+      r.kind = CycleRequest::Kind::kExecutePlan;
+      r.id = next_id();
+      r.plan_id = e.request_id;
+      motion_.command_id = r.id;
+      out_.push_back(r);
+      last_command_utime_ = now_;
+      set_deadline(e.duration_s + s_.motion_margin_s);
+    }
+  }
+  check_timeout();
+  return out_;
+}
+
+std::vector<CycleRequest> LibraryCycle::on_user(const UserEvent& e) {
+  out_.clear();
+  advance_time(e.utime);
+  if (e.event == "abort" && state_ != CycleState::kAborted && state_ != CycleState::kDone) {
+    abort("operator abort" + (e.detail.empty() ? std::string("") : ": " + e.detail));
+  } else if (e.event == "done" && state_ == CycleState::kWaitUser) {
+    message_ = "user \"done\"" + (e.detail.empty() ? std::string("") : ": " + e.detail);
+    succeed(CycleState::kMoveToHolderPreGrasp);
+  }
+  check_timeout();
+  return out_;
+}
+
+}  // namespace bookgrasp

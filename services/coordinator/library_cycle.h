@@ -1,0 +1,304 @@
+#pragma once
+/// @file
+/// The library task as an explicit state machine (paper Sections 1-5): events
+/// in (arm state, markers, arbiter decisions, servo and planner answers, user
+/// events), requests out (servo, plan, arm and gripper commands). No LCM, no
+/// clock: time is the utime of the events (message time).
+///
+/// One book: park -> BwS (the arbiter's P1 check) -> [BSwH stripe servo when
+/// the arbiter has no PS or BwS found nothing] -> move to the BwH start (P1 or
+/// PS) -> BwH servo (rank 0, then rank+1 on NEXT_REGION) -> GRASP -> pre-grasp
+/// -> open -> insert -> close -> extract -> holder pre-place -> place -> release
+/// -> retreat -> park -> wait for the user's "done" -> holder pre-grasp -> open
+/// -> approach -> grasp -> lift -> lower-shelf pre-place -> place -> release ->
+/// retreat -> park -> next book.
+///
+/// The upper shelf is empty when (a) after a book, the room left of it
+/// (GP.y - BW - shelf left end) is narrower than the narrowest admissible book
+/// S_min, or (b) the stripe servo ends within `empty_stripe_margin` of the
+/// shelf's left end, i.e. no book occludes the stripe. BSwH runs whenever BwS
+/// finds no book, so (b) confirms an empty shelf that BwS reports.
+///
+/// Failures before the book is in the gripper start a new attempt at the same
+/// book (back out if inside the shelf, park, BwS again), at most
+/// `max_attempts_per_book`; failures of a step with a book in the gripper or on
+/// the holder repeat that step at most `max_step_retries` times. Beyond either
+/// bound, or on the user event "abort", the cycle aborts cleanly: servo
+/// cancelled, arm stopped, gripper left as it is (a held book stays held),
+/// progress persisted with where the book is.
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Geometry>
+
+#include "common/config.h"
+#include "services/coordinator/cycle_geometry.h"
+#include "services/coordinator/task_progress.h"
+
+namespace bookgrasp {
+
+/// Timeouts, retries and motion parameters of the cycle.
+struct CycleSettings {
+  CycleGeometry geometry;
+  std::vector<double> park_joints;        ///< rad; the arm out of the stereo view
+  // timeouts, seconds of message time
+  double markers_timeout_s = 10;
+  double decision_timeout_s = 10;
+  double servo_timeout_s = 30;
+  double plan_timeout_s = 10;
+  double motion_margin_s = 5;             ///< added to a trajectory's or straight move's nominal duration
+  double gripper_timeout_s = 5;
+  double user_timeout_s = 0;              ///< 0 = wait for "done" forever
+  double auto_done_after_s = 0;           ///< >0: send "done" after this long in WAIT_USER (demo)
+  // retries
+  int max_attempts_per_book = 3;
+  int max_step_retries = 2;
+  // planner
+  std::string planner;                    ///< "" = the planner's default
+  double plan_time_budget_s = 2;
+  double plan_position_tolerance_m = 0.002;
+  double plan_orientation_tolerance_rad = 0.02;
+  double held_book_depth_m = 0.25;        ///< depth assumed for a held book (collision model)
+  // arm commands
+  double heartbeat_period_s = 0.05;       ///< <= 0.1 s: the driver stops after 0.5 s without
+  double linear_max_speed = 0.05;         ///< m/s for straight moves
+  double linear_max_angular_speed = 0.3;  ///< rad/s
+  double linear_gain = 2.0;               ///< 1/s, proportional gain of straight moves
+  double linear_position_tolerance = 0.001;
+  double linear_orientation_tolerance = 0.01;
+  // gripper
+  double gripper_open_width = 0.06;
+  double gripper_open_tolerance = 0.002;
+  double gripper_speed = 0.05;
+  double gripper_force = 60;
+  double gripper_settle_s = 0.2;
+  double gripper_settle_tolerance = 0.0005;
+  double min_book_width = 0.005;          ///< closed below this = nothing grasped
+  // emptiness
+  double empty_stripe_margin = 0.02;
+  double s_min = 0.015;                   ///< narrowest admissible book (paper 4.1: L_max/4)
+  /// Reads everything but the `service:` and `channels:` sections; throws ConfigError naming a bad key.
+  static CycleSettings from_config(const Config& root);
+};
+
+/// The arm driver's report.
+struct ArmEvent {
+  int64_t utime = 0;
+  std::vector<double> joints;
+  Eigen::Isometry3d end_effector = Eigen::Isometry3d::Identity();  ///< gripper TCP in base
+  double gripper_width = 0;
+  bool gripper_contact = false;
+  int state = 0;                          ///< arm_state_t IDLE/EXECUTING/STOPPED/FAULT
+  int64_t active_command_id = 0;
+  std::string message;
+};
+
+/// Marker poses in base (latest frame; a missing one keeps the last seen).
+struct MarkersEvent {
+  int64_t utime = 0;
+  std::optional<Eigen::Isometry3d> cart;
+  std::optional<Eigen::Isometry3d> holder;
+};
+
+/// An arbiter decision (GRASP_POINT).
+struct DecisionEvent {
+  int64_t utime = 0;
+  int64_t request_id = 0;
+  std::string outcome;                    ///< first word of the reason: P1_VALID, GRASP, NEXT_REGION, ...
+  int next_rank = 0;                      ///< NEXT_REGION
+  bool valid = false;
+  bool p1_present = false;                ///< p1_grasp finite
+  Eigen::Isometry3d gp_base = Eigen::Isometry3d::Identity();
+  Eigen::Vector3d gp_grasp = Eigen::Vector3d::Zero();
+  bool ps_present = false;
+  Eigen::Vector3d ps_grasp = Eigen::Vector3d::Zero();
+  std::string reason;
+};
+
+/// A visual-servoing status.
+struct ServoEvent {
+  int64_t utime = 0;
+  int64_t request_id = 0;
+  int mode = 0;                           ///< servo_request_t mode
+  int state = 0;                          ///< servo_status_t state
+  std::string message;
+};
+
+/// A planner answer.
+struct PlanEvent {
+  int64_t utime = 0;
+  int64_t request_id = 0;
+  bool success = false;
+  std::string message;
+  double duration_s = 0;                  ///< of the trajectory
+};
+
+/// A user or operator event ("done", "abort").
+struct UserEvent {
+  int64_t utime = 0;
+  std::string event;
+  std::string detail;
+};
+
+/// One thing the node must send.
+struct CycleRequest {
+  enum class Kind {
+    kServo,         ///< SERVO_REQUEST (mode, pose = start, rank, fixed_depth, timeout)
+    kServoCancel,   ///< SERVO_REQUEST CANCEL
+    kPlan,          ///< PLAN_REQUEST (joints or pose goal, holding_book, book_size)
+    kExecutePlan,   ///< ARM_COMMAND TRAJECTORY with the trajectory of plan `plan_id`
+    kTwist,         ///< ARM_COMMAND CARTESIAN_VELOCITY in base
+    kArmStop,       ///< ARM_COMMAND STOP
+    kHeartbeat,     ///< ARM_COMMAND HEARTBEAT
+    kGripperMove,   ///< GRIPPER_COMMAND MOVE to width
+    kGripperGrasp,  ///< GRIPPER_COMMAND GRASP
+    kUserEvent,     ///< USER_EVENT (the demo's own "done")
+  };
+  Kind kind = Kind::kHeartbeat;
+  int64_t id = 0;                         ///< request / command id
+  int servo_mode = 0;
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+  int rank = 0;
+  double fixed_depth = 0;
+  double timeout_s = 0;
+  bool joints_goal = false;
+  std::vector<double> start_joints;
+  std::vector<double> goal_joints;
+  bool holding_book = false;
+  Eigen::Vector3d book_size = Eigen::Vector3d::Zero();  ///< width, height, depth
+  int64_t plan_id = 0;
+  Eigen::Matrix<double, 6, 1> twist = Eigen::Matrix<double, 6, 1>::Zero();
+  double width = 0;
+  double force = 0;
+  double speed = 0;
+  std::string text;
+  std::string detail;
+};
+
+/// The states of the cycle.
+enum class CycleState {
+  kStart, kWaitMarkers, kBackOut, kPark, kWaitP1Check, kMoveToStripeStart, kServoStripe, kWaitPsCheck,
+  kMoveToBwhStart, kServoBook, kWaitDecision, kMoveToPreGrasp, kOpenForGrasp, kInsert, kCloseGripper, kExtract,
+  kMoveToHolder, kPlaceOnHolder, kReleaseOnHolder, kRetreatFromHolder, kParkForUser, kWaitUser,
+  kMoveToHolderPreGrasp, kOpenForHolderGrasp, kApproachHolder, kGraspFromHolder, kLiftFromHolder,
+  kMoveToLowerShelf, kPlaceOnLowerShelf, kReleaseOnLowerShelf, kRetreatFromLowerShelf, kDone, kAborted,
+};
+
+/// Upper-case name of a state ("WAIT_P1_CHECK", ...), as in TASK_STATUS.state.
+std::string cycle_state_name(CycleState s);
+
+/// What TASK_STATUS says.
+struct CycleStatus {
+  std::string state;
+  int books_total = 0;    ///< books known so far: moved + the current one
+  int books_moved = 0;
+  int current_book = 0;   ///< index of the book being handled (= books_moved)
+  int attempt = 0;        ///< attempt at the current book, 1-based
+  int failures = 0;
+  std::string message;
+};
+
+/// The state machine.
+class LibraryCycle {
+ public:
+  /// Starts fresh, or resumes from `resume` (a persisted progress).
+  LibraryCycle(CycleSettings settings, std::optional<TaskProgress> resume);
+
+  /// Event handlers. Each returns the requests to send, in order.
+  std::vector<CycleRequest> on_arm(const ArmEvent& e);
+  std::vector<CycleRequest> on_markers(const MarkersEvent& e);
+  std::vector<CycleRequest> on_decision(const DecisionEvent& e);
+  std::vector<CycleRequest> on_servo(const ServoEvent& e);
+  std::vector<CycleRequest> on_plan(const PlanEvent& e);
+  std::vector<CycleRequest> on_user(const UserEvent& e);
+
+  /// Current state.
+  CycleState state() const { return state_; }
+  /// The persisted part.
+  const TaskProgress& progress() const { return progress_; }
+  /// Set when the progress changed since the last call (the node then writes the file). Clears the flag.
+  bool take_progress_changed();
+  /// Set when the status changed since the last call. Clears the flag.
+  bool take_status_changed();
+  /// For TASK_STATUS.
+  CycleStatus status() const;
+  /// Message time: the latest event utime.
+  int64_t now() const { return now_; }
+
+ private:
+  enum class MotionKind { kNone, kPlanned, kLinear, kGripperOpen, kGripperGrasp };
+  struct Motion {
+    MotionKind kind = MotionKind::kNone;
+    bool joints_goal = false;
+    std::vector<double> goal_joints;
+    Eigen::Isometry3d goal = Eigen::Isometry3d::Identity();
+    bool holding = false;
+    int64_t plan_id = -1;
+    int64_t command_id = -1;
+    bool planning = false;
+    bool executing = false;
+    std::vector<Eigen::Isometry3d> waypoints;
+    size_t waypoint = 0;
+    int64_t settle_start = -1;
+    double settle_width = 0;
+  };
+
+  void advance_time(int64_t utime);
+  void enter(CycleState s);
+  void succeed(CycleState next);
+  void fail(const std::string& reason);
+  void abort(const std::string& reason);
+  void check_timeout();
+  void set_deadline(double seconds);
+  void start_planned_joints(const std::vector<double>& goal);
+  void start_planned_pose(const Eigen::Isometry3d& goal, bool holding);
+  void start_linear(std::vector<Eigen::Isometry3d> waypoints);
+  void start_gripper(bool grasp);
+  void issue_plan();
+  void drive_motion(const ArmEvent& e);
+  void motion_done();
+  void after_motion();
+  CycleState resume_target() const;
+  void persist();
+  int64_t next_id();
+  Eigen::Isometry3d cart_frame() const;
+  Eigen::Isometry3d holder_frame() const;
+  double tcp_height() const;
+  void handle_p1_check(const DecisionEvent& d);
+  void handle_ps_check(const DecisionEvent& d);
+  void handle_grasp_decision(const DecisionEvent& d);
+  void handle_gripper_result(double width, bool contact);
+
+  CycleSettings s_;
+  TaskProgress progress_;
+  CycleState state_ = CycleState::kStart;
+  CycleState resume_from_ = CycleState::kStart;   ///< the state persisted when the process stopped
+  int64_t now_ = 0;
+  int64_t entry_utime_ = 0;
+  int64_t deadline_ = -1;                          ///< -1 = none
+  int64_t last_id_ = 0;
+  int64_t last_command_utime_ = 0;
+  std::optional<ArmEvent> arm_;
+  std::optional<Eigen::Isometry3d> cart_marker_;
+  std::optional<Eigen::Isometry3d> holder_marker_;
+  Motion motion_;
+  std::vector<CycleRequest> out_;
+  int attempt_ = 1;
+  int step_retries_ = 0;
+  bool stripe_done_this_attempt_ = false;
+  int64_t stripe_request_ = -1;
+  int64_t servo_request_ = -1;
+  int rank_ = 0;
+  Eigen::Vector3d bwh_start_ = Eigen::Vector3d::Zero();
+  std::optional<DecisionEvent> early_decision_;    ///< a decision that arrived before its servo status
+  Eigen::Isometry3d gp_base_ = Eigen::Isometry3d::Identity();
+  bool user_event_sent_ = false;
+  std::string message_;
+  bool progress_changed_ = false;
+  bool status_changed_ = true;
+};
+
+}  // namespace bookgrasp

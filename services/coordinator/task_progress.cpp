@@ -1,0 +1,135 @@
+#include "services/coordinator/task_progress.h"
+
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
+
+#include <yaml-cpp/yaml.h>
+
+namespace bookgrasp {
+
+std::string book_place_name(BookPlace p) {
+  switch (p) {
+    case BookPlace::kUpperShelf: return "upper_shelf";
+    case BookPlace::kInGripperFromShelf: return "gripper_from_shelf";
+    case BookPlace::kOnHolder: return "holder";
+    case BookPlace::kInGripperFromHolder: return "gripper_from_holder";
+  }
+  return "?";
+}
+
+namespace {
+BookPlace place_from_name(const std::string& s, const std::string& source) {
+  for (BookPlace p : {BookPlace::kUpperShelf, BookPlace::kInGripperFromShelf, BookPlace::kOnHolder,
+                      BookPlace::kInGripperFromHolder})
+    if (book_place_name(p) == s) return p;
+  throw std::runtime_error(source + ": place '" + s +
+                           "' is not one of upper_shelf, gripper_from_shelf, holder, gripper_from_holder");
+}
+
+template <typename T>
+T need(const YAML::Node& n, const std::string& key, const std::string& source) {
+  if (!n[key]) throw std::runtime_error(source + ": missing key '" + key + "' (a truncated or foreign progress file?)");
+  try {
+    return n[key].as<T>();
+  } catch (const YAML::Exception& e) {
+    throw std::runtime_error(source + ": key '" + key + "' has the wrong type: " + e.what());
+  }
+}
+}  // namespace
+
+std::string progress_to_yaml(const TaskProgress& p) {
+  YAML::Emitter e;
+  e.SetDoublePrecision(17);
+  e << YAML::BeginMap;
+  e << YAML::Key << "books_moved" << YAML::Value << p.books_moved;
+  e << YAML::Key << "failures" << YAML::Value << p.failures;
+  e << YAML::Key << "place" << YAML::Value << book_place_name(p.place);
+  e << YAML::Key << "have_book_data" << YAML::Value << p.have_book_data;
+  e << YAML::Key << "gp_grasp" << YAML::Value << YAML::Flow << YAML::BeginSeq << p.gp_grasp.x() << p.gp_grasp.y()
+    << p.gp_grasp.z() << YAML::EndSeq;
+  e << YAML::Key << "book_width" << YAML::Value << p.book_width;
+  e << YAML::Key << "lower_next_right_y" << YAML::Value << p.lower_next_right_y;
+  e << YAML::Key << "finished" << YAML::Value << p.finished;
+  e << YAML::Key << "last_state" << YAML::Value << p.last_state;
+  e << YAML::Key << "moved" << YAML::Value << YAML::BeginSeq;
+  for (const MovedBook& b : p.moved)
+    e << YAML::Flow << YAML::BeginMap << YAML::Key << "index" << YAML::Value << b.index << YAML::Key << "width"
+      << YAML::Value << b.width << YAML::Key << "gp_y" << YAML::Value << b.gp_y << YAML::Key << "lower_right_y"
+      << YAML::Value << b.lower_right_y << YAML::EndMap;
+  e << YAML::EndSeq << YAML::EndMap;
+  return std::string(e.c_str()) + "\n";
+}
+
+TaskProgress progress_from_yaml(const std::string& text, const std::string& source) {
+  YAML::Node n;
+  try {
+    n = YAML::Load(text);
+  } catch (const YAML::Exception& e) {
+    throw std::runtime_error(source + ": not valid YAML: " + e.what());
+  }
+  if (!n.IsMap()) throw std::runtime_error(source + ": the progress file is not a YAML mapping");
+  TaskProgress p;
+  p.books_moved = need<int>(n, "books_moved", source);
+  p.failures = need<int>(n, "failures", source);
+  p.place = place_from_name(need<std::string>(n, "place", source), source);
+  p.have_book_data = need<bool>(n, "have_book_data", source);
+  const auto gp = need<std::vector<double>>(n, "gp_grasp", source);
+  if (gp.size() != 3) throw std::runtime_error(source + ": gp_grasp must have 3 numbers");
+  p.gp_grasp = Eigen::Vector3d(gp[0], gp[1], gp[2]);
+  p.book_width = need<double>(n, "book_width", source);
+  p.lower_next_right_y = need<double>(n, "lower_next_right_y", source);
+  p.finished = need<bool>(n, "finished", source);
+  p.last_state = need<std::string>(n, "last_state", source);
+  const YAML::Node moved = n["moved"];
+  if (!moved || !moved.IsSequence()) throw std::runtime_error(source + ": missing list 'moved'");
+  for (const YAML::Node& b : moved) {
+    MovedBook m;
+    m.index = need<int>(b, "index", source);
+    m.width = need<double>(b, "width", source);
+    m.gp_y = need<double>(b, "gp_y", source);
+    m.lower_right_y = need<double>(b, "lower_right_y", source);
+    p.moved.push_back(m);
+  }
+  if (p.books_moved < 0 || p.books_moved != static_cast<int>(p.moved.size()))
+    throw std::runtime_error(source + ": books_moved (" + std::to_string(p.books_moved) +
+                             ") does not match the list 'moved' (" + std::to_string(p.moved.size()) + " entries)");
+  return p;
+}
+
+void save_progress(const std::string& path, const TaskProgress& p) {
+  const std::string tmp = path + ".tmp";
+  const std::string text = progress_to_yaml(p);
+  const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  if (fd < 0) throw std::runtime_error("cannot write progress file " + tmp + ": " + std::strerror(errno));
+  size_t done = 0;
+  while (done < text.size()) {
+    const ssize_t n = ::write(fd, text.data() + done, text.size() - done);
+    if (n < 0) {
+      const std::string err = std::strerror(errno);
+      ::close(fd);
+      throw std::runtime_error("cannot write progress file " + tmp + ": " + err);
+    }
+    done += static_cast<size_t>(n);
+  }
+  if (::fsync(fd) != 0 || ::close(fd) != 0)
+    throw std::runtime_error("cannot flush progress file " + tmp + ": " + std::strerror(errno));
+  if (std::rename(tmp.c_str(), path.c_str()) != 0)
+    throw std::runtime_error("cannot rename " + tmp + " to " + path + ": " + std::strerror(errno));
+}
+
+std::optional<TaskProgress> load_progress(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) return std::nullopt;
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return progress_from_yaml(ss.str(), path);
+}
+
+}  // namespace bookgrasp

@@ -1,0 +1,59 @@
+#pragma once
+/// @file
+/// The coordinator's progress, persisted so a restarted coordinator resumes
+/// without losing or dropping a book: how many books were moved, where the
+/// current book is (upper shelf, in the gripper, on the holder), what is known
+/// about it, and the next free slot on the lower shelf. Written atomically
+/// (temporary file, fsync, rename). No LCM.
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+namespace bookgrasp {
+
+/// Where the current book physically is.
+enum class BookPlace {
+  kUpperShelf,           ///< not taken yet (or no current book)
+  kInGripperFromShelf,   ///< grasped from the upper shelf, not yet released on the holder
+  kOnHolder,             ///< released on the holder, waiting for the user
+  kInGripperFromHolder,  ///< grasped from the holder, not yet released on the lower shelf
+};
+
+/// Name of a place ("upper_shelf", "gripper_from_shelf", "holder", "gripper_from_holder").
+std::string book_place_name(BookPlace p);
+
+/// One book that completed the cycle.
+struct MovedBook {
+  int index = 0;              ///< 0 = first book taken
+  double width = 0;           ///< from the gripper plates, m
+  double gp_y = 0;            ///< grasp-frame Y of its GP (its right cover on the upper shelf), m
+  double lower_right_y = 0;   ///< grasp-frame Y of its right cover on the lower shelf, m
+};
+
+/// Everything persisted.
+struct TaskProgress {
+  int books_moved = 0;                    ///< completed cycles
+  int failures = 0;                       ///< failures (each retried or aborting), all books
+  BookPlace place = BookPlace::kUpperShelf;  ///< where the current book is
+  bool have_book_data = false;            ///< gp_grasp and book_width below are set
+  Eigen::Vector3d gp_grasp = Eigen::Vector3d::Zero();  ///< current book's GP, grasp frame
+  double book_width = 0;                  ///< current book's width (plates), m
+  double lower_next_right_y = 0;          ///< right cover of the next book on the lower shelf, grasp Y
+  bool finished = false;                  ///< the upper shelf is empty
+  std::string last_state;                 ///< state-machine state when written
+  std::vector<MovedBook> moved;           ///< the books moved, in order
+};
+
+/// The progress as YAML text.
+std::string progress_to_yaml(const TaskProgress& p);
+/// Parses progress YAML; throws std::runtime_error naming the bad key.
+TaskProgress progress_from_yaml(const std::string& text, const std::string& source);
+/// Writes `p` to `path` atomically (write `path`.tmp, fsync, rename). Throws std::runtime_error on failure.
+void save_progress(const std::string& path, const TaskProgress& p);
+/// Reads `path`; nullopt if it does not exist. Throws std::runtime_error if it exists but cannot be parsed.
+std::optional<TaskProgress> load_progress(const std::string& path);
+
+}  // namespace bookgrasp
