@@ -5,7 +5,7 @@
 int main(int argc, char** argv) {
   return bookgrasp::run_service_main(
       argc, argv,
-      {"bookgrasp_arm_driver", "arm driver: trajectories, Cartesian velocity, gripper; limits and heartbeat",
+      {"arm_driver", "arm driver: trajectories, Cartesian velocity, gripper; limits and heartbeat",
        "config/services/arm_driver.yaml",
        [](const bookgrasp::Config& root) { return std::make_unique<bookgrasp::ArmDriverNode>(root); }});
 }
