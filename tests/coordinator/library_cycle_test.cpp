@@ -1,0 +1,331 @@
+// The library cycle's state machine driven by scripted events (tests/coordinator/fake_library.h): whole
+// cycles for 3 books, every transition, retries, abort, timeouts and resume from a persisted progress file.
+// Expected states, counts and poses are worked out by hand from the configuration (config/services/
+// coordinator.yaml) and the fake world's books.
+#include "services/coordinator/library_cycle.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "common/config.h"
+#include "tests/coordinator/fake_library.h"
+
+namespace bookgrasp_test {
+namespace {
+
+using bookgrasp::BookPlace;
+using bookgrasp::CycleSettings;
+using bookgrasp::CycleState;
+
+CycleSettings settings() {
+  const auto cfg =
+      bookgrasp::Config::load_file(std::string(BOOKGRASP_SOURCE_DIR) + "/config/services/coordinator.yaml");
+  return CycleSettings::from_config(cfg);
+}
+
+// Three books from the right: widths 25, 20, 30 mm; 2 mm gaps; heights 0.25, 0.18, 0.22 m.
+std::vector<FakeBook> three_books() {
+  return {{0, 0.025, 0.25, 0.300}, {1, 0.020, 0.18, 0.273}, {2, 0.030, 0.22, 0.251}};
+}
+
+int count(const std::vector<std::string>& v, const std::string& s) {
+  return static_cast<int>(std::count(v.begin(), v.end(), s));
+}
+
+std::vector<std::string> slice(const std::vector<std::string>& v, const std::string& from, size_t n) {
+  auto it = std::find(v.begin(), v.end(), from);
+  std::vector<std::string> out;
+  for (; it != v.end() && out.size() < n; ++it) out.push_back(*it);
+  return out;
+}
+
+bool done_or_aborted(const LibraryCycle& c) {
+  return c.state() == CycleState::kDone || c.state() == CycleState::kAborted;
+}
+
+TEST(LibraryCycle, ThreeBooksWholeCycleEveryTransitionAndPlacements) {
+  FakeLibrary w(three_books());
+  LibraryCycle cycle(settings(), std::nullopt);
+  w.run(cycle, [&] { return done_or_aborted(cycle); });
+  ASSERT_EQ(cycle.state(), CycleState::kDone) << cycle.status().message;
+
+  // Book 0 (first run, BSwH for PS), by hand from the state machine's definition.
+  // (The markers arrive before the first arm state, so WAIT_MARKERS is left within that first event.)
+  const std::vector<std::string> first = {
+      "START", "PARK", "WAIT_P1_CHECK", "MOVE_TO_STRIPE_START", "SERVO_STRIPE", "WAIT_PS_CHECK",
+      "MOVE_TO_BWH_START", "SERVO_BOOK", "WAIT_DECISION", "MOVE_TO_PRE_GRASP", "OPEN_FOR_GRASP", "INSERT",
+      "CLOSE_GRIPPER", "EXTRACT", "MOVE_TO_HOLDER", "PLACE_ON_HOLDER", "RELEASE_ON_HOLDER", "RETREAT_FROM_HOLDER",
+      "PARK_FOR_USER", "WAIT_USER", "MOVE_TO_HOLDER_PRE_GRASP", "OPEN_FOR_HOLDER_GRASP", "APPROACH_HOLDER",
+      "GRASP_FROM_HOLDER", "LIFT_FROM_HOLDER", "MOVE_TO_LOWER_SHELF", "PLACE_ON_LOWER_SHELF",
+      "RELEASE_ON_LOWER_SHELF", "RETREAT_FROM_LOWER_SHELF", "PARK", "WAIT_P1_CHECK"};
+  ASSERT_GE(w.states.size(), first.size());
+  EXPECT_EQ(std::vector<std::string>(w.states.begin(), w.states.begin() + first.size()), first);
+  // Book 1: PS known from PS.y = GP.y - BW, so no stripe servo: straight to BwH.
+  const auto second = slice(std::vector<std::string>(w.states.begin() + first.size() - 1, w.states.end()),
+                            "WAIT_P1_CHECK", 3);
+  EXPECT_EQ(second, (std::vector<std::string>{"WAIT_P1_CHECK", "MOVE_TO_BWH_START", "SERVO_BOOK"}));
+  // End: BwS finds nothing -> BSwH -> stripe end at the shelf's left end -> park -> DONE.
+  const std::vector<std::string> tail(w.states.end() - 6, w.states.end());
+  EXPECT_EQ(tail, (std::vector<std::string>{"WAIT_P1_CHECK", "MOVE_TO_STRIPE_START", "SERVO_STRIPE", "WAIT_PS_CHECK",
+                                            "PARK", "DONE"}));
+  EXPECT_EQ(count(w.states, "SERVO_STRIPE"), 2);
+  EXPECT_EQ(count(w.states, "RELEASE_ON_LOWER_SHELF"), 3);
+
+  // Every book accounted for, in order, none lost or duplicated.
+  EXPECT_TRUE(w.upper.empty());
+  EXPECT_FALSE(w.in_gripper);
+  EXPECT_FALSE(w.on_holder);
+  ASSERT_EQ(w.lower.size(), 3u);
+  for (int i = 0; i < 3; ++i) EXPECT_EQ(w.lower[i].first.id, i);
+  const auto& p = cycle.progress();
+  EXPECT_EQ(p.books_moved, 3);
+  EXPECT_TRUE(p.finished);
+  ASSERT_EQ(p.moved.size(), 3u);
+  EXPECT_NEAR(p.moved[1].width, 0.020, 1e-12);
+  EXPECT_EQ(p.failures, 0);
+  EXPECT_EQ(cycle.status().state, "DONE");
+  EXPECT_EQ(cycle.status().books_moved, 3);
+
+  // Lower shelf: right covers at 0.37, 0.37 - 0.025 - 0.005 = 0.34, 0.34 - 0.020 - 0.005 = 0.315;
+  // TCP Y = right - BW/2; X = -0.35 + height + 0.005; Z = 0.01 + 0.03. Base = (0.60 + Z, -0.05 - Y, X).
+  const double ys[3] = {0.37 - 0.0125, 0.34 - 0.010, 0.315 - 0.015};
+  const double hs[3] = {0.25, 0.18, 0.22};
+  for (int i = 0; i < 3; ++i) {
+    const Eigen::Vector3d tcp = w.lower[i].second.translation();
+    EXPECT_NEAR(tcp.x(), 0.64, 0.0015) << "book " << i;
+    EXPECT_NEAR(tcp.y(), -0.05 - ys[i], 0.0015) << "book " << i;
+    EXPECT_NEAR(tcp.z(), -0.35 + hs[i] + 0.005, 0.0015) << "book " << i;
+  }
+  // Holder: support origin (0.301, 0.28, -0.09), base axes; TCP (-0.02, 0.215, h + 0.005) in it.
+  ASSERT_EQ(w.holder_drops.size(), 3u);
+  const Eigen::Vector3d h0 = w.holder_drops[0].second.translation();
+  EXPECT_NEAR(h0.x(), 0.281, 0.0015);
+  EXPECT_NEAR(h0.y(), 0.495, 0.0015);
+  EXPECT_NEAR(h0.z(), -0.09 + 0.25 + 0.005, 0.0015);
+  // Gripper axes on the holder: x up (base z), y = -base x, z = -base y.
+  const Eigen::Matrix3d r = w.holder_drops[0].second.linear();
+  EXPECT_NEAR(r(2, 0), 1.0, 0.02);
+  EXPECT_NEAR(r(0, 1), -1.0, 0.02);
+  EXPECT_NEAR(r(1, 2), -1.0, 0.02);
+
+  // Arm-command duties: heartbeats while trajectories run; twist speeds within the configured limit.
+  int heartbeats = 0;
+  for (const auto& q : w.requests) {
+    if (q.kind == CycleRequest::Kind::kHeartbeat) ++heartbeats;
+    if (q.kind == CycleRequest::Kind::kTwist) {
+      EXPECT_LE(q.twist.head<3>().norm(), 0.05 + 1e-12);
+    }
+  }
+  EXPECT_GT(heartbeats, 0);
+}
+
+TEST(LibraryCycle, RetriesNextRegionNoGraspMissedGraspAndPlanFailure) {
+  FakeLibrary w(three_books());
+  w.next_region_once = 1;   // BwH rank 0 picks a false region once
+  w.no_grasp_once = 0;
+  w.missed_grasps = 1;      // the first close finds nothing
+  w.plan_failures["MOVE_TO_HOLDER"] = 1;  // one step retry with the book in the gripper
+  LibraryCycle cycle(settings(), std::nullopt);
+  w.run(cycle, [&] { return done_or_aborted(cycle); });
+  ASSERT_EQ(cycle.state(), CycleState::kDone) << cycle.status().message;
+  EXPECT_EQ(w.lower.size(), 3u);
+  // NEXT_REGION: back to the BwH start and servo again with rank 1.
+  int rank1 = 0;
+  for (const auto& q : w.requests)
+    if (q.kind == CycleRequest::Kind::kServo && q.servo_mode == 1 && q.rank == 1) ++rank1;
+  EXPECT_EQ(rank1, 1);
+  // Missed grasp: back out of the shelf (inside it), park, new attempt.
+  const auto after_close = slice(w.states, "CLOSE_GRIPPER", 4);
+  EXPECT_EQ(after_close, (std::vector<std::string>{"CLOSE_GRIPPER", "BACK_OUT", "PARK", "WAIT_P1_CHECK"}));
+  EXPECT_EQ(cycle.progress().failures, 2) << "missed grasp + one planning failure";
+  EXPECT_EQ(count(w.states, "BACK_OUT"), 1);
+}
+
+TEST(LibraryCycle, NoGraspFromTheArbiterStartsANewAttempt) {
+  FakeLibrary w(three_books());
+  w.no_grasp_once = 1;
+  LibraryCycle cycle(settings(), std::nullopt);
+  w.run(cycle, [&] { return cycle.state() == CycleState::kMoveToPreGrasp; });
+  EXPECT_EQ(cycle.status().attempt, 2);
+  EXPECT_EQ(slice(w.states, "WAIT_DECISION", 3), (std::vector<std::string>{"WAIT_DECISION", "PARK", "WAIT_P1_CHECK"}));
+  // The failed attempt cancelled the servo (opening a new attempt in the arbiter).
+  int cancels = 0;
+  for (const auto& q : w.requests)
+    if (q.kind == CycleRequest::Kind::kServoCancel) ++cancels;
+  EXPECT_GE(cancels, 2) << "one at start, one after NO_GRASP";
+}
+
+TEST(LibraryCycle, BoundedRetriesAbortCleanly) {
+  FakeLibrary w(three_books());
+  w.plan_failures["MOVE_TO_BWH_START"] = 100;
+  LibraryCycle cycle(settings(), std::nullopt);
+  w.run(cycle, [&] { return done_or_aborted(cycle); });
+  ASSERT_EQ(cycle.state(), CycleState::kAborted);
+  EXPECT_EQ(cycle.progress().failures, 3) << "max_attempts_per_book = 3";
+  EXPECT_NE(cycle.status().message.find("3 attempts failed"), std::string::npos) << cycle.status().message;
+  EXPECT_NE(cycle.status().message.find("scripted planning failure"), std::string::npos);
+  // Clean abort: servo cancelled and arm stopped last; the book is still on the upper shelf.
+  ASSERT_GE(w.requests.size(), 2u);
+  EXPECT_EQ(w.requests[w.requests.size() - 2].kind, CycleRequest::Kind::kServoCancel);
+  EXPECT_EQ(w.requests.back().kind, CycleRequest::Kind::kArmStop);
+  EXPECT_EQ(w.upper.size(), 3u);
+  EXPECT_EQ(cycle.progress().place, BookPlace::kUpperShelf);
+}
+
+TEST(LibraryCycle, StepFailuresWithABookHeldAbortKeepingTheBook) {
+  FakeLibrary w(three_books());
+  w.plan_failures["MOVE_TO_LOWER_SHELF"] = 100;
+  LibraryCycle cycle(settings(), std::nullopt);
+  w.run(cycle, [&] { return done_or_aborted(cycle); });
+  ASSERT_EQ(cycle.state(), CycleState::kAborted);
+  EXPECT_EQ(cycle.progress().failures, 3) << "first try + max_step_retries 2";
+  EXPECT_EQ(cycle.progress().place, BookPlace::kInGripperFromHolder);
+  EXPECT_EQ(cycle.progress().last_state, "MOVE_TO_LOWER_SHELF");
+  ASSERT_TRUE(w.in_gripper);
+  EXPECT_EQ(w.in_gripper->id, 0);
+  // No gripper command after the abort: the book stays held.
+  EXPECT_NE(w.requests.back().kind, CycleRequest::Kind::kGripperMove);
+}
+
+TEST(LibraryCycle, ServoTimeoutInMessageTimeIsAFailure) {
+  FakeLibrary w(three_books());
+  w.servo_silent = true;
+  LibraryCycle cycle(settings(), std::nullopt);
+  w.run(cycle, [&] { return cycle.state() == CycleState::kServoStripe; });
+  const int64_t start = w.t;
+  w.run(cycle, [&] { return cycle.state() != CycleState::kServoStripe; });
+  // servo_s 30 + decision_s 10 of message time (10 ms ticks).
+  EXPECT_NEAR(static_cast<double>(w.t - start) * 1e-6, 40.0, 0.02);
+  EXPECT_NE(cycle.status().message.find("timeout in SERVO_STRIPE"), std::string::npos) << cycle.status().message;
+  EXPECT_EQ(cycle.status().attempt, 2);
+}
+
+TEST(LibraryCycle, OperatorAbortAndAutomaticDone) {
+  {
+    FakeLibrary w(three_books());
+    LibraryCycle cycle(settings(), std::nullopt);
+    w.run(cycle, [&] { return cycle.state() == CycleState::kInsert; });
+    bookgrasp::UserEvent u;
+    u.utime = w.t;
+    u.event = "abort";
+    u.detail = "test";
+    cycle.on_user(u);
+    EXPECT_EQ(cycle.state(), CycleState::kAborted);
+    EXPECT_NE(cycle.status().message.find("operator abort: test"), std::string::npos);
+  }
+  {
+    FakeLibrary w(three_books());
+    w.user_answers = false;
+    CycleSettings s = settings();
+    s.auto_done_after_s = 2.0;
+    LibraryCycle cycle(s, std::nullopt);
+    w.run(cycle, [&] { return cycle.state() == CycleState::kWaitUser; });
+    const int64_t start = w.t;
+    w.run(cycle, [&] { return cycle.state() != CycleState::kWaitUser; });
+    EXPECT_NEAR(static_cast<double>(w.t - start) * 1e-6, 2.0, 0.011);
+    EXPECT_EQ(w.user_events_sent, std::vector<std::string>{"done"});
+  }
+}
+
+TEST(LibraryCycle, EmptyByRoomRuleWhenTheLastBookReachesTheLeftEnd) {
+  // One book whose left cover is 10 mm from the shelf's left end (-0.40): room 10 mm < S_min 15 mm.
+  FakeLibrary w({{0, 0.020, 0.20, -0.370}});
+  LibraryCycle cycle(settings(), std::nullopt);
+  w.run(cycle, [&] { return done_or_aborted(cycle); });
+  ASSERT_EQ(cycle.state(), CycleState::kDone) << cycle.status().message;
+  EXPECT_EQ(count(w.states, "SERVO_STRIPE"), 1) << "no BSwH check needed after the last book";
+  EXPECT_NE(cycle.status().message.find("S_min"), std::string::npos) << cycle.status().message;
+}
+
+/// Runs until `stop`, persists the progress to a file, reloads it into a new cycle (a restarted
+/// coordinator) and finishes; every book must end on the lower shelf exactly once, in order.
+void resume_at(const std::function<bool(const LibraryCycle&, const FakeLibrary&)>& stop, const char* name) {
+  SCOPED_TRACE(name);
+  FakeLibrary w(three_books());
+  auto first = std::make_unique<LibraryCycle>(settings(), std::nullopt);
+  w.run(*first, [&] { return stop(*first, w); });
+  ASSERT_FALSE(done_or_aborted(*first));
+  const std::string path = testing::TempDir() + "/progress_" + name + ".yaml";
+  bookgrasp::save_progress(path, first->progress());
+  const auto loaded = bookgrasp::load_progress(path);
+  ASSERT_TRUE(loaded);
+  first.reset();  // the old process is gone
+  LibraryCycle second(settings(), loaded);
+  w.run(second, [&] { return done_or_aborted(second); });
+  ASSERT_EQ(second.state(), CycleState::kDone) << second.status().message;
+  ASSERT_EQ(w.lower.size(), 3u);
+  for (int i = 0; i < 3; ++i) EXPECT_EQ(w.lower[i].first.id, i);
+  EXPECT_EQ(second.progress().books_moved, 3);
+  EXPECT_FALSE(w.in_gripper);
+  EXPECT_FALSE(w.on_holder);
+  std::remove(path.c_str());
+}
+
+TEST(LibraryCycle, ResumeFromPersistedFileMidCycleAccountsForEveryBook) {
+  resume_at([](const LibraryCycle& c, const FakeLibrary&) { return c.state() == CycleState::kMoveToHolder; },
+            "book_in_gripper");
+  resume_at([](const LibraryCycle& c, const FakeLibrary&) { return c.state() == CycleState::kExtract; },
+            "extracting");
+  resume_at(
+      [](const LibraryCycle& c, const FakeLibrary&) {
+        return c.state() == CycleState::kWaitUser && c.progress().books_moved == 1;
+      },
+      "second_book_on_holder");
+  resume_at([](const LibraryCycle& c, const FakeLibrary&) { return c.state() == CycleState::kLiftFromHolder; },
+            "taken_from_holder");
+  resume_at([](const LibraryCycle& c, const FakeLibrary&) { return c.state() == CycleState::kInsert; },
+            "inserting");
+}
+
+TEST(LibraryCycle, ResumeWithABookExpectedInTheGripperButNoContactAborts) {
+  FakeLibrary w(three_books());
+  LibraryCycle first(settings(), std::nullopt);
+  w.run(first, [&] { return first.state() == CycleState::kMoveToHolder; });
+  bookgrasp::TaskProgress p = first.progress();
+  w.contact = false;  // the book fell out while the coordinator was down
+  w.in_gripper.reset();
+  LibraryCycle second(settings(), p);
+  w.run(second, [&] { return done_or_aborted(second); }, 1000);
+  ASSERT_EQ(second.state(), CycleState::kAborted);
+  EXPECT_NE(second.status().message.find("no contact"), std::string::npos) << second.status().message;
+}
+
+TEST(TaskProgress, RoundTripAndCorruptFilesAreNamed) {
+  bookgrasp::TaskProgress p;
+  p.books_moved = 1;
+  p.failures = 2;
+  p.place = BookPlace::kOnHolder;
+  p.have_book_data = true;
+  p.gp_grasp = Eigen::Vector3d(0.25, 0.3, 0.01);
+  p.book_width = 0.025;
+  p.lower_next_right_y = 0.34;
+  p.last_state = "WAIT_USER";
+  p.moved.push_back({0, 0.02, 0.31, 0.37});
+  const auto q = bookgrasp::progress_from_yaml(bookgrasp::progress_to_yaml(p), "test");
+  EXPECT_EQ(q.books_moved, 1);
+  EXPECT_EQ(q.place, BookPlace::kOnHolder);
+  EXPECT_EQ(q.gp_grasp, p.gp_grasp);
+  EXPECT_EQ(q.book_width, 0.025);
+  EXPECT_EQ(q.last_state, "WAIT_USER");
+  ASSERT_EQ(q.moved.size(), 1u);
+  EXPECT_EQ(q.moved[0].lower_right_y, 0.37);
+  EXPECT_THROW(bookgrasp::progress_from_yaml("books_moved: 1\n", "x"), std::runtime_error);
+  try {
+    bookgrasp::progress_from_yaml("books_moved: 2\nfailures: 0\nplace: holder\nhave_book_data: false\n"
+                                  "gp_grasp: [0, 0, 0]\nbook_width: 0\nlower_next_right_y: 0\nfinished: false\n"
+                                  "last_state: PARK\nmoved: []\n",
+                                  "f.yaml");
+    FAIL();
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("books_moved"), std::string::npos) << e.what();
+  }
+  EXPECT_FALSE(bookgrasp::load_progress(testing::TempDir() + "/does_not_exist.yaml"));
+}
+
+}  // namespace
+}  // namespace bookgrasp_test
