@@ -187,6 +187,7 @@ void CoordinatorNode::send(const std::vector<CycleRequest>& requests, int64_t ut
         m.mode = r.kind == CycleRequest::Kind::kServoCancel ? servo_request_t::CANCEL
                                                              : static_cast<int8_t>(r.servo_mode);
         m.start_pose = isometry_to_pose(r.pose, "base", "gripper", utime);
+        if (r.kind == CycleRequest::Kind::kServoCancel) m.start_pose.frame = "";  // no start pose
         m.fixed_depth_m = r.fixed_depth;
         m.rank_from_right = r.rank;
         m.timeout_s = r.timeout_s;
