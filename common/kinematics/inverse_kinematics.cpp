@@ -24,7 +24,8 @@ InverseKinematics::InverseKinematics(ArmKinematics kinematics, IkParams params)
 }
 
 IkResult InverseKinematics::solve_once(const Eigen::Isometry3d& target, const Eigen::VectorXd& seed_q,
-                                       int max_iterations) const {
+                                       int max_iterations, int posture_iterations) const {
+  const int posture_budget = posture_iterations >= 0 ? posture_iterations : params_.posture_iterations;
   const int n = kin_.num_joints();
   const Eigen::VectorXd& lo = kin_.lower_limits();
   const Eigen::VectorXd& hi = kin_.upper_limits();
@@ -38,7 +39,7 @@ IkResult InverseKinematics::solve_once(const Eigen::Isometry3d& target, const Ei
   Eigen::Matrix<double, 6, 1> err;
   double pos_err = 0, rot_err = 0;
   Eigen::VectorXd best_q = q;  // last iterate within the tolerances
-  int posture_left = params_.posture_iterations;
+  int posture_left = posture_budget;
   for (int it = 0;; ++it) {
     kin_.tip_pose_and_jacobian(q, tip, jac);
     err.head<3>() = target.translation() - tip.translation();
@@ -58,7 +59,7 @@ IkResult InverseKinematics::solve_once(const Eigen::Isometry3d& target, const Ei
       pos_err = p_err;
       rot_err = o_err;
     }
-    if (it >= max_iterations + (r.success ? params_.posture_iterations : 0)) break;
+    if (it >= max_iterations + (r.success ? posture_budget : 0)) break;
     r.iterations = it + 1;
     // Weighted task: orientation rows scaled to metres so damping acts evenly.
     jac.bottomRows<3>() *= w;

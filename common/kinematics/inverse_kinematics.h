@@ -56,8 +56,11 @@ class InverseKinematics {
   /// Same with an explicit restart seed (overrides params.seed).
   IkResult solve(const Eigen::Isometry3d& target, const Eigen::VectorXd& seed_q, uint64_t restart_seed) const;
   /// One attempt from `seed_q` only (no restarts), at most `max_iterations`
-  /// iterations. Used by samplers that make their own seeds.
-  IkResult solve_once(const Eigen::Isometry3d& target, const Eigen::VectorXd& seed_q, int max_iterations) const;
+  /// iterations. Used by samplers that make their own seeds. `posture_iterations`
+  /// overrides params.posture_iterations when >= 0 (0 = stop at the first
+  /// converged iterate, staying close to the seed).
+  IkResult solve_once(const Eigen::Isometry3d& target, const Eigen::VectorXd& seed_q, int max_iterations,
+                      int posture_iterations = -1) const;
 
   /// The arm.
   const ArmKinematics& kinematics() const { return kin_; }

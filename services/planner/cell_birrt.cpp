@@ -164,7 +164,7 @@ bool CellBiRRT::sample_cell(const Tree& tree, Eigen::VectorXd& q) {
       seed = static_cast<int>(i);
     }
   }
-  const IkResult r = ik_.solve_once(target, tree[seed].q, params_.ik_iterations);
+  const IkResult r = ik_.solve_once(target, tree[seed].q, params_.ik_iterations, 0);
   if (!r.success || !state_ok(r.q)) {
     cell_weights_[cell] = std::max(params_.min_cell_weight * 1e-3, cell_weights_[cell] * params_.failure_decay);
     return false;
@@ -180,9 +180,22 @@ CellBiRRT::Grow CellBiRRT::extend(Tree& tree, const Eigen::VectorXd& target, int
   const double d = (target - from).norm();
   Grow result = Grow::kReached;
   Eigen::VectorXd to = target;
-  if (d > params_.range_rad) {
-    to = from + (params_.range_rad / d) * (target - from);
+  // With the orientation kept, steps are shorter and each new node is projected back onto the
+  // constraint (IK to its own tool position with the kept orientation).
+  const double range = problem_.keep_orientation ? 0.5 * params_.range_rad : params_.range_rad;
+  if (d > range) {
+    to = from + (range / d) * (target - from);
     result = Grow::kAdvanced;
+    if (problem_.keep_orientation) {
+      Eigen::Isometry3d on_manifold = Eigen::Isometry3d::Identity();
+      on_manifold.translation() = ik_.kinematics().tip_pose(to).translation();
+      on_manifold.linear() = problem_.constrained_orientation;
+      const IkResult r = ik_.solve_once(on_manifold, to, params_.ik_iterations, 0);
+      if (!r.success) return Grow::kTrapped;
+      to = r.q;
+      // The projection may undo the step: require real progress, or the connect loop would not end.
+      if ((target - to).norm() > d - 0.25 * range) return Grow::kTrapped;
+    }
   }
   if (!motion_ok(from, to)) return Grow::kTrapped;
   added = add_node(tree, to, near);

@@ -345,8 +345,12 @@ PlanOutcome MotionPlanner::plan(const PlanningScene& scene, const PlanRequest& r
   planner->setup();
   const ob::PlannerStatus status = planner->solve(ob::timedPlannerTerminationCondition(req.time_budget_s));
   if (status != ob::PlannerStatus::EXACT_SOLUTION || !pdef->hasExactSolution()) {
+    std::string detail = "status: " + status.asString();
+    if (cell)
+      detail += ", " + std::to_string(cell->tree_size()) + " nodes, cell samples " +
+                std::to_string(cell->cell_samples_ok()) + "/" + std::to_string(cell->cell_samples_tried());
     return fail(PlanFailure::kTimeout, out.planner + " found no path within the time budget of " +
-                                           fmt(req.time_budget_s) + " s (status: " + status.asString() + ")");
+                                           fmt(req.time_budget_s) + " s (" + detail + ")");
   }
   const auto* path = pdef->getSolutionPath()->as<og::PathGeometric>();
   for (size_t i = 0; i < path->getStateCount(); ++i) out.raw_path.push_back(from_state(path->getState(i), n));

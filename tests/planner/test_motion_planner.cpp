@@ -1,0 +1,235 @@
+// MotionPlanner: paths never pass through obstacles (dense exact re-check with
+// FCL), pose goals are reached, limits hold, failures carry their reasons.
+#include "services/planner/motion_planner.h"
+
+#include <gtest/gtest.h>
+
+#include "services/planner/planner_config.h"
+
+namespace bookgrasp {
+namespace {
+
+const std::string kConfig = std::string(BOOKGRASP_SOURCE_DIR) + "/config/services/planner.yaml";
+
+SceneBox box(const std::string& name, const Eigen::Vector3d& centre, const Eigen::Vector3d& size) {
+  SceneBox b;
+  b.name = name;
+  b.pose.translation() = centre;
+  b.size = size;
+  return b;
+}
+
+Eigen::VectorXd q7(double a, double b, double c, double d, double e, double f, double g) {
+  return (Eigen::VectorXd(7) << a, b, c, d, e, f, g).finished();
+}
+
+class MotionPlannerTest : public ::testing::Test {
+ protected:
+  MotionPlannerTest() : settings_(PlannerSettings::load(kConfig)), stack_(settings_) {
+    // A pillar in front of the robot and a floor: start on the left of it, goal on the right.
+    scene_ = std::make_unique<PlanningScene>(stack_.scene);
+    scene_->set_environment({box("pillar", {0.55, 0.0, 0.1}, {0.2, 0.2, 1.2}), box("floor", {0, 0, -0.6}, {3, 3, 0.1})});
+    start_ = q7(-1.0, 1.2, 0.0, 0.8, 0.0, 0.6, 0.0);
+    goal_ = q7(1.0, 1.2, 0.0, 0.8, 0.0, 0.6, 0.0);
+  }
+  PlannerSettings settings_;
+  PlannerStack stack_;
+  std::unique_ptr<PlanningScene> scene_;
+  Eigen::VectorXd start_, goal_;
+};
+
+void expect_collision_free(const PlanningScene& scene, const PlanOutcome& r) {
+  ASSERT_TRUE(r.success) << r.message;
+  for (size_t i = 1; i < r.path.size(); ++i)
+    EXPECT_TRUE(segment_collision_free(scene, r.path[i - 1], r.path[i], 0.001, false))
+        << "segment " << i << " passes through an obstacle";
+  // The timed samples too.
+  for (const auto& p : r.trajectory.points) EXPECT_FALSE(scene.check(p.position, false).collision);
+}
+
+TEST_F(MotionPlannerTest, ProblemNeedsAPlan) {
+  ASSERT_TRUE(scene_->is_valid(start_));
+  ASSERT_TRUE(scene_->is_valid(goal_));
+  ASSERT_FALSE(segment_collision_free(*scene_, start_, goal_, 0.01, false)) << "straight line should hit the pillar";
+}
+
+TEST_F(MotionPlannerTest, EveryPlannerAvoidsThePillar) {
+  for (const std::string name : {"CellBiRRT", "RRTConnect", "BiTRRT"}) {
+    PlanRequest req;
+    req.start = start_;
+    req.goal_joints = goal_;
+    req.planner = name;
+    req.time_budget_s = 2.0;
+    req.seed = 5;
+    const PlanOutcome r = stack_.planner.plan(*scene_, req);
+    SCOPED_TRACE(name);
+    expect_collision_free(*scene_, r);
+    EXPECT_EQ(r.planner, name);
+    EXPECT_TRUE(r.path.front().isApprox(start_));
+    EXPECT_TRUE(r.path.back().isApprox(goal_));
+    double length = 0;
+    for (size_t i = 1; i < r.path.size(); ++i) length += (r.path[i] - r.path[i - 1]).norm();
+    EXPECT_NEAR(r.path_length_rad, length, 1e-9);
+  }
+}
+
+TEST_F(MotionPlannerTest, TrajectoryRespectsTheConfiguredLimits) {
+  PlanRequest req;
+  req.start = start_;
+  req.goal_joints = goal_;
+  req.time_budget_s = 2.0;
+  const PlanOutcome r = stack_.planner.plan(*scene_, req);
+  ASSERT_TRUE(r.success) << r.message;
+  const auto& pts = r.trajectory.points;
+  ASSERT_GE(pts.size(), 2u);
+  EXPECT_EQ(pts.front().time_s, 0.0);
+  for (size_t i = 1; i < pts.size(); ++i) {
+    const double h = pts[i].time_s - pts[i - 1].time_s;
+    ASSERT_GT(h, 0);
+    EXPECT_LE(h, settings_.planner.sample_period_s + 1e-9);
+    const Eigen::VectorXd v = (pts[i].position - pts[i - 1].position) / h;
+    for (int j = 0; j < 7; ++j) {
+      EXPECT_LE(std::abs(v[j]), settings_.planner.max_velocity[j] * (1 + 1e-6));
+      EXPECT_LE(std::abs(pts[i].acceleration[j]), settings_.planner.max_acceleration[j] * (1 + 1e-9));
+    }
+  }
+}
+
+TEST_F(MotionPlannerTest, PoseGoalIsReachedWithinTolerance) {
+  // Gripper horizontal, pointing forward (x_g up), to the right of the pillar.
+  Eigen::Isometry3d goal = Eigen::Isometry3d::Identity();
+  goal.linear().col(0) = Eigen::Vector3d::UnitZ();
+  goal.linear().col(1) = -Eigen::Vector3d::UnitY();
+  goal.linear().col(2) = Eigen::Vector3d::UnitX();
+  goal.translation() = Eigen::Vector3d(0.55, -0.45, 0.3);
+  PlanRequest req;
+  req.start = start_;
+  req.goal_is_pose = true;
+  req.goal_pose = goal;
+  req.position_tolerance_m = 0.001;
+  req.orientation_tolerance_rad = 0.01;
+  req.time_budget_s = 2.0;
+  const PlanOutcome r = stack_.planner.plan(*scene_, req);
+  expect_collision_free(*scene_, r);
+  const Eigen::Isometry3d reached = stack_.kinematics.tip_pose(r.path.back());
+  EXPECT_LT((reached.translation() - goal.translation()).norm(), 0.001);
+  EXPECT_LT(Eigen::AngleAxisd(reached.linear().transpose() * goal.linear()).angle(), 0.01);
+}
+
+TEST_F(MotionPlannerTest, KeepOrientationHoldsTheGripperAlongThePath) {
+  // Move a horizontally held gripper from the left of a low wall to the right, keeping its orientation:
+  // it must rise over the wall (passing in front is out of reach: the wrist would come too close to
+  // the shoulder).
+  scene_->set_environment({box("wall", {0.55, 0.0, 0.0}, {0.2, 0.1, 0.8}), box("floor", {0, 0, -0.6}, {3, 3, 0.1})});
+  Eigen::Matrix3d r0;
+  r0.col(0) = Eigen::Vector3d::UnitZ();
+  r0.col(1) = -Eigen::Vector3d::UnitY();
+  r0.col(2) = Eigen::Vector3d::UnitX();
+  Eigen::Isometry3d a = Eigen::Isometry3d::Identity(), b = Eigen::Isometry3d::Identity();
+  a.linear() = b.linear() = r0;
+  a.translation() = Eigen::Vector3d(0.55, 0.35, 0.3);
+  b.translation() = Eigen::Vector3d(0.55, -0.35, 0.3);
+  const IkResult ia = stack_.ik.solve(a, settings_.ik.preferred_posture);
+  ASSERT_TRUE(ia.success && scene_->is_valid(ia.q)) << ia.reason;
+  PlanRequest req;
+  req.start = ia.q;
+  req.goal_is_pose = true;
+  req.goal_pose = b;
+  req.position_tolerance_m = 0.001;
+  req.orientation_tolerance_rad = 0.1;
+  req.keep_orientation = true;
+  req.time_budget_s = 3.0;
+  req.planner = "CellBiRRT";
+  const PlanOutcome r = stack_.planner.plan(*scene_, req);
+  expect_collision_free(*scene_, r);
+  // Dense check of the orientation band along the whole path.
+  for (size_t i = 1; i < r.path.size(); ++i) {
+    for (int k = 0; k <= 100; ++k) {
+      const Eigen::VectorXd q = r.path[i - 1] + (k / 100.0) * (r.path[i] - r.path[i - 1]);
+      const double angle = Eigen::AngleAxisd(stack_.kinematics.tip_pose(q).linear().transpose() * r0).angle();
+      EXPECT_LE(angle, 0.1 + 0.01) << "segment " << i << " step " << k;
+    }
+  }
+}
+
+TEST_F(MotionPlannerTest, FailureReasons) {
+  PlanRequest req;
+  req.start = start_;
+  req.goal_joints = goal_;
+  req.time_budget_s = 1.0;
+
+  PlanRequest unknown = req;
+  unknown.planner = "PRM*";
+  PlanOutcome r = stack_.planner.plan(*scene_, unknown);
+  EXPECT_EQ(r.failure, PlanFailure::kUnknownPlanner);
+  EXPECT_NE(r.message.find("PRM*"), std::string::npos);
+
+  PlanRequest nan = req;
+  nan.start[2] = NAN;
+  EXPECT_EQ(stack_.planner.plan(*scene_, nan).failure, PlanFailure::kInvalidRequest);
+  PlanRequest size = req;
+  size.goal_joints = Eigen::VectorXd::Zero(6);
+  EXPECT_EQ(stack_.planner.plan(*scene_, size).failure, PlanFailure::kInvalidRequest);
+  PlanRequest limits = req;
+  limits.goal_joints[1] = 2.5;
+  EXPECT_EQ(stack_.planner.plan(*scene_, limits).failure, PlanFailure::kInvalidRequest);
+
+  // Start inside the pillar: arm pointing straight at it (q2 = pi/2 puts the forearm through x = 0.55).
+  PlanRequest in = req;
+  in.start = q7(0, 1.5707963, 0, 0, 0, 0, 0);
+  r = stack_.planner.plan(*scene_, in);
+  EXPECT_EQ(r.failure, PlanFailure::kStartInCollision);
+  EXPECT_NE(r.message.find("pillar"), std::string::npos) << r.message;
+
+  PlanRequest goal_in = req;
+  goal_in.goal_joints = q7(0, 1.5707963, 0, 0, 0, 0, 0);
+  EXPECT_EQ(stack_.planner.plan(*scene_, goal_in).failure, PlanFailure::kGoalInCollision);
+
+  // A pose 2 m away: no IK.
+  PlanRequest far = req;
+  far.goal_is_pose = true;
+  far.goal_pose.translation() = Eigen::Vector3d(2.0, 0, 0.3);
+  r = stack_.planner.plan(*scene_, far);
+  EXPECT_EQ(r.failure, PlanFailure::kNoIk);
+
+  // A reachable pose whose every solution puts the gripper inside the pillar: TCP in the pillar
+  // (x 0.45 .. 0.65, y +-0.1), pointing down.
+  PlanRequest pose_in = req;
+  pose_in.goal_is_pose = true;
+  pose_in.goal_pose = Eigen::Isometry3d::Identity();
+  pose_in.goal_pose.linear().col(0) = Eigen::Vector3d::UnitX();
+  pose_in.goal_pose.linear().col(1) = -Eigen::Vector3d::UnitY();
+  pose_in.goal_pose.linear().col(2) = -Eigen::Vector3d::UnitZ();
+  pose_in.goal_pose.translation() = Eigen::Vector3d(0.55, 0.0, 0.3);
+  EXPECT_EQ(stack_.planner.plan(*scene_, pose_in).failure, PlanFailure::kGoalInCollision);
+
+  // The pillar blocks the straight line, so no planner can answer within a microsecond.
+  for (const std::string name : {"CellBiRRT", "RRTConnect", "BiTRRT"}) {
+    PlanRequest rushed = req;
+    rushed.planner = name;
+    rushed.time_budget_s = 1e-6;
+    r = stack_.planner.plan(*scene_, rushed);
+    EXPECT_EQ(r.failure, PlanFailure::kTimeout) << name << ": " << r.message;
+  }
+  PlanRequest budget = req;
+  budget.time_budget_s = -1;
+  EXPECT_EQ(stack_.planner.plan(*scene_, budget).failure, PlanFailure::kInvalidRequest);
+}
+
+TEST_F(MotionPlannerTest, SameSeedSamePath) {
+  PlanRequest req;
+  req.start = start_;
+  req.goal_joints = goal_;
+  req.time_budget_s = 2.0;
+  req.seed = 11;
+  for (const std::string name : {"CellBiRRT", "RRTConnect"}) {
+    req.planner = name;
+    const PlanOutcome a = stack_.planner.plan(*scene_, req), b = stack_.planner.plan(*scene_, req);
+    ASSERT_TRUE(a.success && b.success);
+    ASSERT_EQ(a.path.size(), b.path.size()) << name;
+    for (size_t i = 0; i < a.path.size(); ++i) EXPECT_TRUE(a.path[i] == b.path[i]) << name;
+  }
+}
+
+}  // namespace
+}  // namespace bookgrasp
