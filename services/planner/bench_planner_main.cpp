@@ -39,7 +39,7 @@ double percentile(std::vector<double> v, double p) {
 
 struct Stats {
   int runs = 0, ok = 0, violations = 0;
-  std::vector<double> ms, length;
+  std::vector<double> ms, length, ik_ms, search_ms, simplify_ms;
   std::map<std::string, int> failures;
   std::map<std::string, std::pair<int, int>> by_kind;  // ok, runs
 };
@@ -112,6 +112,9 @@ int main(int argc, char** argv) {
         ++s.runs;
         ++s.by_kind[q.kind].second;
         s.ms.push_back(1000.0 * r.planning_time_s);
+        s.ik_ms.push_back(1000.0 * r.goal_ik_time_s);
+        s.search_ms.push_back(1000.0 * r.search_time_s);
+        s.simplify_ms.push_back(1000.0 * r.simplify_time_s);
         if (r.success) {
           ++s.ok;
           ++s.by_kind[q.kind].first;
@@ -151,6 +154,8 @@ int main(int argc, char** argv) {
       js << "    \"ms\": {\"median\": " << percentile(s.ms, 0.5) << ", \"p95\": " << percentile(s.ms, 0.95)
          << ", \"max\": " << percentile(s.ms, 1.0) << "},\n";
       js << "    \"path_length\": {\"median\": " << percentile(s.length, 0.5) << "},\n";
+      js << "    \"parts_ms_median\": {\"goal_ik\": " << percentile(s.ik_ms, 0.5) << ", \"search\": "
+         << percentile(s.search_ms, 0.5) << ", \"simplify\": " << percentile(s.simplify_ms, 0.5) << "},\n";
       js << "    \"runs\": " << s.runs << ",\n    \"failures\": {";
       bool first = true;
       for (const auto& [k, v] : s.failures) {
@@ -175,6 +180,8 @@ int main(int argc, char** argv) {
                 << 100.0 * s.ok / std::max(1, s.runs) << " %  ms median " << percentile(s.ms, 0.5) << " p95 "
                 << percentile(s.ms, 0.95) << " max " << percentile(s.ms, 1.0) << "  path median "
                 << std::setprecision(2) << percentile(s.length, 0.5) << " rad";
+      std::cout << "  [median ms: goal IK " << std::setprecision(1) << percentile(s.ik_ms, 0.5) << ", search "
+                << percentile(s.search_ms, 0.5) << ", simplify " << percentile(s.simplify_ms, 0.5) << "]";
       if (verify) std::cout << "  dense violations " << s.violations;
       std::cout << "\n";
     }

@@ -41,18 +41,28 @@ Eigen::VectorXd from_state(const ob::State* s, int n) {
   return q;
 }
 
-// Interpolated check of a straight joint-space segment; `a` is not re-checked.
+// Interpolated check of a straight joint-space segment; `a` is not re-checked. Without
+// `last_valid_fraction` the points are visited coarse to fine (bisection order), which finds a
+// collision on a long segment after a few checks; the set of points checked is the same.
 bool segment_ok(const StateCheck& valid, const Eigen::VectorXd& a, const Eigen::VectorXd& b, double resolution,
                 double* last_valid_fraction = nullptr) {
   const int steps = std::max(1, static_cast<int>(std::ceil((b - a).norm() / resolution)));
+  if (!last_valid_fraction) {
+    int top = 1;
+    while (top < steps) top *= 2;
+    for (int stride = top; stride >= 1; stride /= 2)
+      for (int i = stride; i <= steps; i += 2 * stride)
+        if (!valid(a + (static_cast<double>(i) / steps) * (b - a))) return false;
+    return true;
+  }
   for (int i = 1; i <= steps; ++i) {
     const double t = static_cast<double>(i) / steps;
     if (!valid(a + t * (b - a))) {
-      if (last_valid_fraction) *last_valid_fraction = static_cast<double>(i - 1) / steps;
+      *last_valid_fraction = static_cast<double>(i - 1) / steps;
       return false;
     }
   }
-  if (last_valid_fraction) *last_valid_fraction = 1.0;
+  *last_valid_fraction = 1.0;
   return true;
 }
 
@@ -242,19 +252,32 @@ PlanOutcome MotionPlanner::plan(const PlanningScene& scene, const PlanRequest& r
                                                      fmt(rotation_angle(req.goal_pose.linear(), kept)) + " rad, more than the tolerance");
     std::mt19937_64 rng(req.seed ^ 0x9e3779b97f4a7c15ULL);
     std::uniform_real_distribution<double> unit(0.0, 1.0);
+    std::normal_distribution<double> jitter(0.0, 0.5);
     int ik_ok = 0;
     std::string ik_reason, collision;
+    Eigen::VectorXd closest;  // failed attempt that came closest: later seeds also perturb it
+    double closest_error = INFINITY;
     for (int attempt = 0; attempt < params_.goal_ik_attempts &&
                           static_cast<int>(goals.size()) < params_.goal_ik_solutions; ++attempt) {
       Eigen::VectorXd seed(n);
-      if (attempt == 0) seed = start;
-      else if (attempt == 1) seed = ik_.params().preferred_posture;
-      else
+      if (attempt == 0) {
+        seed = start;
+      } else if (attempt == 1) {
+        seed = ik_.params().preferred_posture;
+      } else if (attempt % 2 == 1 && closest.size() == n) {
+        for (int k = 0; k < n; ++k) seed[k] = closest[k] + jitter(rng);
+      } else {
         for (int k = 0; k < n; ++k)
           seed[k] = kin.lower_limits()[k] + unit(rng) * (kin.upper_limits()[k] - kin.lower_limits()[k]);
+      }
       const IkResult r = ik_.solve_once(req.goal_pose, seed, ik_.params().max_iterations);
       if (!r.success) {
         ik_reason = r.reason;
+        const double e = r.position_error_m + ik_.params().orientation_weight_m * r.orientation_error_rad;
+        if (e < closest_error) {
+          closest_error = e;
+          closest = r.q;
+        }
         continue;
       }
       ++ik_ok;
@@ -275,6 +298,7 @@ PlanOutcome MotionPlanner::plan(const PlanningScene& scene, const PlanRequest& r
                                                      " IK solutions of the goal pose are in collision, e.g. " + collision);
   }
 
+  out.goal_ik_time_s = elapsed();
   // ---- OMPL problem ----
   auto space = std::make_shared<ob::RealVectorStateSpace>(n);
   ob::RealVectorBounds bounds(n);
@@ -322,12 +346,29 @@ PlanOutcome MotionPlanner::plan(const PlanningScene& scene, const PlanRequest& r
     problem.keep_orientation = keep;
     problem.constrained_orientation = kept;
     problem.seed = seed;
-    const auto& env = scene.environment();
-    problem.point_free = [&env](const Eigen::Vector3d& p) {
-      for (const SceneBox& b : env) {
-        const Eigen::Vector3d local = b.pose.inverse() * p;
-        if ((local.cwiseAbs() - 0.5 * b.size).maxCoeff() < 0) return false;
+    // Cell centres inside an obstacle or out of the arm's reach are not used.
+    struct Obstacle {
+      Eigen::Isometry3d inverse;
+      Eigen::Vector3d half;
+    };
+    std::vector<Obstacle> obstacles;
+    for (const SceneBox& b : scene.environment()) obstacles.push_back({b.pose.inverse(), 0.5 * b.size});
+    const std::vector<Eigen::Isometry3d> zero_links = kin.link_poses(Eigen::VectorXd::Zero(n));
+    const int shoulder_link = kin.model().joints.empty() ? 0 : [&] {
+      // Child link of the second movable joint on the chain: the shoulder centre of an LWA3-type arm.
+      int count = 0;
+      for (size_t l = 0; l < kin.model().links.size(); ++l) {
+        const int j = kin.model().links[l].parent_joint;
+        if (j >= 0 && kin.model().joints[j].kind != RobotJoint::Kind::kFixed && ++count == 2) return static_cast<int>(l);
       }
+      return 0;
+    }();
+    const Eigen::Vector3d shoulder = zero_links[shoulder_link].translation();
+    const double reach = (zero_links[kin.tip_link()].translation() - shoulder).norm() + params_.cell_size_m;
+    problem.point_free = [obstacles, shoulder, reach](const Eigen::Vector3d& p) {
+      if ((p - shoulder).norm() > reach) return false;
+      for (const Obstacle& o : obstacles)
+        if (((o.inverse * p).cwiseAbs() - o.half).maxCoeff() < 0) return false;
       return true;
     };
     cell = std::make_shared<CellBiRRT>(si, ik_, cp, problem);
@@ -343,7 +384,9 @@ PlanOutcome MotionPlanner::plan(const PlanningScene& scene, const PlanRequest& r
   }
   planner->setProblemDefinition(pdef);
   planner->setup();
+  const double search_begin = elapsed();
   const ob::PlannerStatus status = planner->solve(ob::timedPlannerTerminationCondition(req.time_budget_s));
+  out.search_time_s = elapsed() - search_begin;
   if (status != ob::PlannerStatus::EXACT_SOLUTION || !pdef->hasExactSolution()) {
     std::string detail = "status: " + status.asString();
     if (cell)
@@ -359,10 +402,12 @@ PlanOutcome MotionPlanner::plan(const PlanningScene& scene, const PlanRequest& r
   const MotionCheck motion = [&](const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
     return segment_ok(valid, a, b, params_.collision_resolution_rad);
   };
+  const double simplify_begin = elapsed();
   out.path = simplify_path(out.raw_path, motion, params_.simplify_shortcuts, seed);
   out.trajectory = parameterize_trapezoidal(out.path, params_.max_velocity, params_.max_acceleration,
                                             params_.sample_period_s);
   out.path_length_rad = path_length(out.path);
+  out.simplify_time_s = elapsed() - simplify_begin;
   out.success = true;
   out.failure = PlanFailure::kNone;
   std::ostringstream msg;

@@ -56,7 +56,10 @@ struct PlanOutcome {
   std::vector<Eigen::VectorXd> path;   ///< simplified waypoints (start first)
   std::vector<Eigen::VectorXd> raw_path;  ///< waypoints as the planner found them
   TimedTrajectory trajectory;          ///< time-parameterised path
-  double planning_time_s = 0.0;        ///< search + simplification, wall clock
+  double planning_time_s = 0.0;        ///< everything (checks, goal IK, search, simplification), wall clock
+  double goal_ik_time_s = 0.0;         ///< part of planning_time_s spent on goal IK
+  double search_time_s = 0.0;          ///< part spent in the planner's search
+  double simplify_time_s = 0.0;        ///< part spent simplifying and timing the path
   double path_length_rad = 0.0;        ///< joint-space length of `path`
 };
 
