@@ -179,7 +179,8 @@ MjcfDocument build_mjcf(const Scene& s) {
   x << "  <compiler angle=\"radian\" inertiafromgeom=\"auto\"/>\n";
   x << "  <option timestep=\"" << num(ph.timestep_s) << "\" cone=\"elliptic\" impratio=\"" << num(ph.impratio)
     << "\" integrator=\"implicit\"/>\n";
-  x << "  <size nconmax=\"3000\" njmax=\"8000\"/>\n";
+  // njmax sizes dense njmax x njmax buffers in mjData (8000 would memset 0.5 GB): ~40 contacts need ~200 rows.
+  x << "  <size nconmax=\"600\" njmax=\"2000\"/>\n";
   // Fixed statistic: znear/zfar and shadow clipping scale with the extent; keep them independent of the books.
   {
     const Eigen::Vector3d c = s.cart_pose * Eigen::Vector3d(0, 0, 0);

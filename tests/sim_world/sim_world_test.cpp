@@ -254,6 +254,9 @@ TEST_P(ScriptedGrasp, LiftsOutTheRightmostBookAndLeavesTheNeighbours) {
     EXPECT_LT(moved, 0.005) << after.books[i].name << " moved " << moved << " m";
     EXPECT_EQ(after.books[i].place, "upper_shelf");
   }
+  // The model's contact and constraint buffers were large enough throughout.
+  EXPECT_EQ(w.model().data()->warning[mjWARN_CONTACTFULL].number, 0);
+  EXPECT_EQ(w.model().data()->warning[mjWARN_CNSTRFULL].number, 0);
   // A new right-most book.
   int rightmost = -1;
   for (int i = 0; i < after.num_books; ++i)
