@@ -168,6 +168,13 @@ image_t encode_jpeg(const cv::Mat& mat, int64_t utime, const std::string& frame,
   return encode(mat, image_t::JPEG, ".jpg", {cv::IMWRITE_JPEG_QUALITY, quality}, utime, frame, 0.0f);
 }
 
+image_t encode_image(const cv::Mat& mat, const std::string& encoding, int64_t utime, const std::string& frame) {
+  if (encoding == "png") return encode_png(mat, utime, frame);
+  if (encoding == "jpeg") return encode_jpeg(mat, utime, frame, 90);
+  if (encoding == "raw") return mat_to_image(mat, mat.channels() == 3 ? image_t::RGB8 : image_t::GRAY8, utime, frame);
+  throw ImageError("unknown image encoding '" + encoding + "' (raw, png or jpeg)");
+}
+
 void write_png(const std::string& path, const cv::Mat& mat) {
   cv::Mat out;
   if (mat.type() == CV_8UC3) cv::cvtColor(mat, out, cv::COLOR_RGB2BGR);

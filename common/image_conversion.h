@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include <opencv2/core.hpp>
 
@@ -45,6 +46,17 @@ image_t encode_png(const cv::Mat& mat, int64_t utime, const std::string& frame, 
 
 /// Encodes a CV_8UC1 or CV_8UC3 (RGB) Mat as a JPEG message of `quality` (1-100).
 image_t encode_jpeg(const cv::Mat& mat, int64_t utime, const std::string& frame, int quality = 90);
+
+/// The encodings a camera may publish: "raw" (RGB8 / GRAY8), "png" (lossless),
+/// "jpeg" (quality 90; ~8x smaller, for recordings).
+inline const std::vector<std::string>& image_encodings() {
+  static const std::vector<std::string> names{"raw", "png", "jpeg"};
+  return names;
+}
+
+/// Encodes a CV_8UC3 (RGB) or CV_8UC1 image as `encoding` (one of image_encodings()).
+/// Throws ImageError for another encoding.
+image_t encode_image(const cv::Mat& mat, const std::string& encoding, int64_t utime, const std::string& frame);
 
 /// Writes a CV_8UC1, CV_8UC3 (RGB) or CV_16UC1 Mat to a PNG file. Throws ImageError on failure.
 void write_png(const std::string& path, const cv::Mat& mat);

@@ -24,8 +24,7 @@ hand_image_t make_hand_image(const cv::Mat& rgb, const camera_calibration_t& cal
   hand_image_t m;
   m.utime = utime;
   m.sequence = sequence;
-  m.image = encoding == "png" ? encode_png(rgb, utime, calibration.frame)
-                              : mat_to_image(rgb, image_t::RGB8, utime, calibration.frame);
+  m.image = encode_image(rgb, encoding, utime, calibration.frame);
   m.calibration = calibration;
   m.calibration.utime = utime;
   m.calibration.camera_in_base.utime = utime;
@@ -39,7 +38,7 @@ HandCameraSettings HandCameraSettings::from_config(const Config& root) {
   s.sim_state_channel = root.get<std::string>("channels.sim_state");
   s.output_channel = root.get<std::string>("channels.output");
   s.backend = root.get_choice("backend", {"sim", "files"});
-  s.image_encoding = root.get_choice("image_encoding", {"raw", "png"});
+  s.image_encoding = root.get_choice("image_encoding", image_encodings());
   s.scene_file = resolve(root.get<std::string>("sim.scene_file"));
   s.seed = root.get<int64_t>("sim.seed");
   if (s.seed < 0) throw ConfigError(root.source() + ": sim.seed must be >= 0");

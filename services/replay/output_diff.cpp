@@ -1,6 +1,7 @@
 #include "services/replay/output_diff.h"
 
 #include <algorithm>
+#include <cstdint>
 #include <cmath>
 #include <cstdio>
 #include <regex>
@@ -103,7 +104,8 @@ void compare_fields(const LoggedMessage& a, const LoggedMessage& b, std::map<std
 }  // namespace
 
 DiffReport diff_outputs(const std::vector<LoggedMessage>& recorded, const std::vector<LoggedMessage>& replayed,
-                        const std::set<std::string>& channels_in, const std::set<std::string>& ignore) {
+                        const std::set<std::string>& channels_in, const std::set<std::string>& ignore,
+                        const std::set<int64_t>& fed_utimes) {
   std::set<std::string> channels = channels_in;
   if (channels.empty())
     for (const auto& m : replayed) channels.insert(m.channel);
@@ -152,12 +154,18 @@ DiffReport diff_outputs(const std::vector<LoggedMessage>& recorded, const std::v
           if (agg.example.empty()) agg.example = d.example;
         }
       }
-      cd.missing += static_cast<int>(list.size() - n);
+      const int unmatched = static_cast<int>(list.size() - n);
+      if (!fed_utimes.empty() && !fed_utimes.count(t)) cd.unreplayable += unmatched;
+      else cd.missing += unmatched;
     }
+    const int64_t last_recorded = rec.empty() ? INT64_MIN : rec.rbegin()->first;
     for (const auto& [t, list] : rep) {
       auto it = rec.find(t);
       const size_t have = it == rec.end() ? 0 : it->second.size();
-      if (list.size() > have) cd.extra += static_cast<int>(list.size() - have);
+      if (list.size() <= have) continue;
+      const int surplus = static_cast<int>(list.size() - have);
+      if (!fed_utimes.empty() && t > last_recorded) cd.after_log_end += surplus;
+      else cd.extra += surplus;
     }
     for (auto& [k, d] : fields) {
       if (d.messages > 0) d.mean_abs /= d.messages;
@@ -172,17 +180,19 @@ DiffReport diff_outputs(const std::vector<LoggedMessage>& recorded, const std::v
 
 bool DiffReport::identical() const {
   for (const auto& c : channels)
-    if (c.differing || c.missing || c.extra || c.matched != c.recorded) return false;
+    if (c.differing || c.missing || c.extra || c.matched + c.unreplayable != c.recorded) return false;
   return true;
 }
 
 std::string DiffReport::markdown() const {
   std::ostringstream o;
-  o << "| channel | type | recorded | replayed | matched | identical | differing | missing | extra |\n"
-    << "|---|---|---|---|---|---|---|---|---|\n";
+  o << "| channel | type | recorded | replayed | matched | identical | differing | missing | extra | input not in log "
+       "| after log end |\n"
+    << "|---|---|---|---|---|---|---|---|---|---|---|\n";
   for (const auto& c : channels)
     o << "| " << c.channel << " | " << c.type << " | " << c.recorded << " | " << c.replayed << " | " << c.matched
-      << " | " << c.identical << " | " << c.differing << " | " << c.missing << " | " << c.extra << " |\n";
+      << " | " << c.identical << " | " << c.differing << " | " << c.missing << " | " << c.extra << " | "
+      << c.unreplayable << " | " << c.after_log_end << " |\n";
   for (const auto& c : channels) {
     if (c.fields.empty()) continue;
     o << "\n### " << c.channel << ": fields that moved\n\n| field | messages | max abs diff | mean abs diff | example |\n"
@@ -203,7 +213,8 @@ std::string DiffReport::json() const {
     o << (first ? "" : ", ") << "\"" << json_escape(c.channel) << "\": {\"type\": \"" << c.type
       << "\", \"recorded\": " << c.recorded << ", \"replayed\": " << c.replayed << ", \"matched\": " << c.matched
       << ", \"identical\": " << c.identical << ", \"differing\": " << c.differing << ", \"missing\": " << c.missing
-      << ", \"extra\": " << c.extra << ", \"fields\": [";
+      << ", \"extra\": " << c.extra << ", \"unreplayable\": " << c.unreplayable
+      << ", \"after_log_end\": " << c.after_log_end << ", \"fields\": [";
     bool ff = true;
     for (const auto& f : c.fields) {
       o << (ff ? "" : ", ") << "{\"path\": \"" << json_escape(f.path) << "\", \"messages\": " << f.messages

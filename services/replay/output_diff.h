@@ -32,6 +32,8 @@ struct ChannelDiff {
   int differing = 0;         ///< matched pairs that differ
   int missing = 0;           ///< recorded, not replayed
   int extra = 0;             ///< replayed, not recorded
+  int unreplayable = 0;      ///< recorded, but its input (same utime) is not in the log: not counted as missing
+  int after_log_end = 0;     ///< replayed after the channel's last recorded message: not counted as extra
   std::vector<FieldDiff> fields;  ///< fields that moved, largest first
 };
 
@@ -50,8 +52,14 @@ struct DiffReport {
 /// every channel the replay produced). Messages pair up by utime (the k-th
 /// message with a given utime on a channel pairs with the k-th replayed one).
 /// Fields ignored: any path in `ignore_fields` (e.g. timing fields like "total_ms").
+/// Log boundaries: if `fed_utimes` (utimes of the messages fed to the replay) is
+/// given, a recorded output with no fed input of the same utime is `unreplayable`,
+/// and replayed outputs later than the channel's last recorded one are
+/// `after_log_end` (the recording stopped before they were published); neither
+/// makes the comparison differ.
 DiffReport diff_outputs(const std::vector<LoggedMessage>& recorded, const std::vector<LoggedMessage>& replayed,
                         const std::set<std::string>& channels = {},
-                        const std::set<std::string>& ignore_fields = {});
+                        const std::set<std::string>& ignore_fields = {},
+                        const std::set<int64_t>& fed_utimes = {});
 
 }  // namespace bookgrasp

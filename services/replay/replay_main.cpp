@@ -97,7 +97,7 @@ int main(int argc, char** argv) {
     for (const auto& s : services) std::cerr << " " << s;
     std::cerr << "\n";
     const auto run = bookgrasp::replay_log(log, std::move(components), feed);
-    const auto report = bookgrasp::diff_outputs(log, run.outputs, {}, ignore);
+    const auto report = bookgrasp::diff_outputs(log, run.outputs, {}, ignore, run.fed_utimes);
     ::mkdir(out_dir.c_str(), 0755);
     bookgrasp::write_lcm_log(out_dir + "/replayed.lcm", run.outputs);
     const double speed = run.wall_s > 0 ? run.log_duration_s / run.wall_s : 0.0;

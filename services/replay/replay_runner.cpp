@@ -60,6 +60,7 @@ ReplayRun replay_log(const std::vector<LoggedMessage>& log, std::vector<std::uni
     comp.spin();   // everything it caused
     ++run.messages_fed;
     const int64_t t = m.message_utime();
+    run.fed_utimes.insert(t);
     if (first < 0) first = t;
     last = std::max(last, t);
   }

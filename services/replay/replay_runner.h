@@ -18,6 +18,7 @@ namespace bookgrasp {
 struct ReplayRun {
   std::vector<LoggedMessage> outputs;  ///< everything the components published, in order
   std::set<std::string> fed_channels;  ///< channels taken from the log
+  std::set<int64_t> fed_utimes;        ///< message utimes of the fed messages
   int64_t messages_fed = 0;
   double log_duration_s = 0;           ///< message time spanned by the fed messages
   double wall_s = 0;                   ///< how long the replay took

@@ -17,11 +17,6 @@ std::string resolve(const std::string& path) {
   return (std::filesystem::path(kSourceDir) / path).string();
 }
 
-image_t encode_image(const cv::Mat& rgb, int64_t utime, const std::string& frame, const std::string& encoding) {
-  if (encoding == "png") return encode_png(rgb, utime, frame);
-  return mat_to_image(rgb, image_t::RGB8, utime, frame);
-}
-
 }  // namespace
 
 StereoCameraSettings StereoCameraSettings::from_config(const Config& root) {
@@ -29,7 +24,7 @@ StereoCameraSettings StereoCameraSettings::from_config(const Config& root) {
   s.sim_state_channel = root.get<std::string>("channels.sim_state");
   s.output_channel = root.get<std::string>("channels.output");
   s.backend = root.get_choice("backend", {"sim", "files"});
-  s.image_encoding = root.get_choice("image_encoding", {"raw", "png"});
+  s.image_encoding = root.get_choice("image_encoding", image_encodings());
   s.scene_file = resolve(root.get<std::string>("sim.scene_file"));
   s.seed = root.get<int64_t>("sim.seed");
   if (s.seed < 0) throw ConfigError(root.source() + ": sim.seed must be >= 0");
@@ -54,8 +49,8 @@ stereo_frame_t make_stereo_frame(const cv::Mat& left_rgb, const cv::Mat& right_r
   stereo_frame_t f;
   f.utime = utime;
   f.sequence = sequence;
-  f.left = encode_image(left_rgb, utime, left.frame, encoding);
-  f.right = encode_image(right_rgb, utime, right.frame, encoding);
+  f.left = encode_image(left_rgb, encoding, utime, left.frame);
+  f.right = encode_image(right_rgb, encoding, utime, right.frame);
   f.left_calibration = left;
   f.right_calibration = right;
   f.left_calibration.utime = utime;

@@ -33,7 +33,7 @@ struct StereoCameraSettings {
   std::string sim_state_channel;   ///< channels.sim_state (sim_state_t, sim backend)
   std::string output_channel;      ///< channels.output (stereo_frame_t)
   std::string backend;             ///< backend: "sim" or "files"
-  std::string image_encoding;      ///< image_encoding: "raw" (RGB8) or "png"
+  std::string image_encoding;      ///< image_encoding: "raw" (RGB8), "png" or "jpeg"
 
   std::string scene_file;          ///< sim.scene_file (absolute, resolved)
   int64_t seed = 0;                ///< sim.seed

@@ -117,3 +117,21 @@ TEST(ImageConversion, BadMessagesGiveClearErrors) {
 
 }  // namespace
 }  // namespace bookgrasp
+
+namespace bookgrasp {
+namespace {
+
+TEST(ImageConversion, EncodeImageByName) {
+  cv::Mat rgb(48, 64, CV_8UC3, cv::Scalar(10, 120, 240));
+  EXPECT_EQ(encode_image(rgb, "raw", 1, "c").pixel_format, image_t::RGB8);
+  EXPECT_EQ(encode_image(rgb, "png", 1, "c").pixel_format, image_t::PNG);
+  const image_t j = encode_image(rgb, "jpeg", 1, "c");
+  EXPECT_EQ(j.pixel_format, image_t::JPEG);
+  EXPECT_LT(cv::norm(image_to_mat(j), rgb, cv::NORM_INF), 4.0);
+  cv::Mat gray(8, 8, CV_8UC1, cv::Scalar(7));
+  EXPECT_EQ(encode_image(gray, "raw", 1, "c").pixel_format, image_t::GRAY8);
+  EXPECT_THROW(encode_image(rgb, "webp", 1, "c"), ImageError);
+}
+
+}  // namespace
+}  // namespace bookgrasp

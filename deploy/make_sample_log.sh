@@ -1,0 +1,28 @@
+#!/usr/bin/env bash
+# Records a small sample log of the running system for the replay tests: every process of
+# deploy/processes.txt, cameras publishing JPEG (so the log stays small), for N seconds of
+# wall time after all services report alive.
+#   deploy/make_sample_log.sh OUT.lcm [SECONDS]
+set -euo pipefail
+ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+OUT="$1"; SECONDS_TO_RECORD="${2:-3}"
+TMP=$(mktemp -d)
+export BOOKGRASP_RUN_DIR="$TMP/run"
+export BOOKGRASP_LCM_URL="udpm://239.255.76.67:7611?ttl=0&recv_buf_size=4194304"
+export BOOKGRASP_PROCESSES="$TMP/processes.txt"
+cleanup() { "$ROOT/deploy/bookgrasp" stop >/dev/null 2>&1 || true; rm -rf "$TMP"; }
+trap cleanup EXIT
+# The same processes; camera configurations switched to JPEG in temporary copies.
+while read -r name binary config; do
+  case "$name" in \#*|"") continue ;; esac
+  if [[ "$name" == *camera ]]; then
+    sed 's/^image_encoding: raw/image_encoding: jpeg/' "$ROOT/$config" > "$TMP/$name.yaml"
+    config="$TMP/$name.yaml"
+  fi
+  echo "$name $binary ${config#$ROOT/}"
+done < "$ROOT/deploy/processes.txt" > "$BOOKGRASP_PROCESSES"
+names=$(awk '{print $1}' "$BOOKGRASP_PROCESSES" | paste -sd, -)
+"$ROOT/deploy/bookgrasp" start
+"$ROOT/build/services/monitor/bookgrasp_monitor" --lcm-url "$BOOKGRASP_LCM_URL" --expect "$names" --timeout 60 >/dev/null
+timeout --signal=INT "$SECONDS_TO_RECORD" lcm-logger --lcm-url="$BOOKGRASP_LCM_URL" --quiet "$OUT" || true
+echo "wrote $OUT ($(du -h "$OUT" | cut -f1))"
