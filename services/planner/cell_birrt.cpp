@@ -180,9 +180,9 @@ CellBiRRT::Grow CellBiRRT::extend(Tree& tree, const Eigen::VectorXd& target, int
   const double d = (target - from).norm();
   Grow result = Grow::kReached;
   Eigen::VectorXd to = target;
-  // With the orientation kept, steps are shorter and each new node is projected back onto the
-  // constraint (IK to its own tool position with the kept orientation).
-  const double range = problem_.keep_orientation ? 0.5 * params_.range_rad : params_.range_rad;
+  // With the orientation kept, each new node is projected back onto the constraint (IK to its own
+  // tool position with the kept orientation).
+  const double range = params_.range_rad;
   if (d > range) {
     to = from + (range / d) * (target - from);
     result = Grow::kAdvanced;
@@ -219,7 +219,7 @@ ob::PlannerStatus CellBiRRT::solve(const ob::PlannerTerminationCondition& ptc) {
   }
   if (trees_[1].empty()) return ob::PlannerStatus::INVALID_GOAL;
 
-  const double p_cell = problem_.keep_orientation ? 1.0 : params_.cell_sample_probability;
+  const double p_cell = params_.cell_sample_probability;
   std::uniform_real_distribution<double> unit(0.0, 1.0);
   int a = 0;  // tree that grows towards the sample this round
   Eigen::VectorXd sample;
@@ -228,13 +228,7 @@ ob::PlannerStatus CellBiRRT::solve(const ob::PlannerTerminationCondition& ptc) {
     Tree& tb = trees_[1 - a];
     bool have = false;
     if (unit(rng_) < p_cell) have = sample_cell(ta, sample);
-    if (!have) {
-      if (problem_.keep_orientation) {
-        a = 1 - a;
-        continue;
-      }
-      sample_uniform(sample);
-    }
+    if (!have) sample_uniform(sample);
     int added = -1;
     if (extend(ta, sample, added) != Grow::kTrapped) {
       // Connect: grow the other tree towards the new node until it gets there or is blocked.

@@ -37,7 +37,7 @@ struct CellBiRrtParams {
   double tube_sigma_m = 0.25;             ///< cell weight exp(-d^2 / 2 sigma^2), d = distance to the start-goal segment
   double min_cell_weight = 0.02;          ///< floor of a cell's weight (every free cell stays selectable)
   double failure_decay = 0.7;             ///< weight factor applied to a cell each time it gives no sample
-  double cell_sample_probability = 0.8;   ///< cell samples vs uniform joint samples (1.0 when orientation is kept)
+  double cell_sample_probability = 0.8;   ///< cell samples vs uniform joint samples
   double orientation_noise_rad = 0.5;     ///< orientation spread of free (unconstrained) cell samples
   int ik_iterations = 40;                 ///< IK iterations per cell sample
 };
