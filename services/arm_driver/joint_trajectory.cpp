@@ -65,14 +65,17 @@ std::string validate_trajectory(const JointTrajectory& tr, const Eigen::VectorXd
     }
     if (k > 0) {
       const double dt = tr.times[k] - tr.times[k - 1];
+      // Messages carry times in whole microseconds: each end of the segment may be off by 0.5 us,
+      // so the mean rates below are known only to a relative 1 us / dt.
+      const double rt_seg = rt + 1e-6 / dt;
       for (int j = 0; j < n; ++j) {
         const double mean_v = std::abs(q[j] - tr.positions[k - 1][j]) / dt;
-        if (mean_v > lim.max_velocity[j] * rt)
+        if (mean_v > lim.max_velocity[j] * rt_seg)
           return wp + "joint " + lim.joint_names[j] + fmt(" moves at %.3f rad/s on average > limit %.3f", mean_v,
                                                           lim.max_velocity[j]);
         if (!tr.velocities.empty()) {
           const double mean_a = std::abs(tr.velocities[k][j] - tr.velocities[k - 1][j]) / dt;
-          if (mean_a > lim.max_acceleration[j] * rt)
+          if (mean_a > lim.max_acceleration[j] * rt_seg)
             return wp + "joint " + lim.joint_names[j] +
                    fmt(" accelerates at %.3f rad/s^2 on average > limit %.3f", mean_a, lim.max_acceleration[j]);
         }

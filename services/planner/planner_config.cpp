@@ -52,6 +52,10 @@ PlannerSettings PlannerSettings::from_config(const Config& root) {
   const Config col = root.child("collision");
   s.scene.environment_margin_m = col.get_double("environment_margin_m", 0.0, 0.5);
   s.scene.self_margin_m = col.get_double("self_margin_m", 0.0, 0.5);
+  s.scene.tool_min = vec3(col, "tool_workspace_min");
+  s.scene.tool_max = vec3(col, "tool_workspace_max");
+  if ((s.scene.tool_max - s.scene.tool_min).minCoeff() <= 0)
+    throw ConfigError(root.source() + ": " + col.path_of("tool_workspace_max") + " must exceed tool_workspace_min");
   for (const std::string& pair : col.get<std::vector<std::string>>("allowed_pairs")) {
     std::istringstream in(pair);
     std::string a, b, extra;

@@ -206,6 +206,13 @@ CollisionReport PlanningScene::check(const Eigen::VectorXd& q, bool with_margins
   CollisionReport report;
   std::vector<Eigen::Isometry3d> links;
   kin_.link_poses(q, params_.finger_position_m, links);
+  const Eigen::Vector3d tool = links[kin_.tip_link()].translation();
+  if ((tool.array() < params_.tool_min.array()).any() || (tool.array() > params_.tool_max.array()).any()) {
+    report.collision = true;
+    report.first = kin_.model().links[kin_.tip_link()].name;
+    report.second = "tool workspace bounds";
+    return report;
+  }
   const auto& parts = geo_->parts;
   std::vector<Eigen::Isometry3d> pose(parts.size());
   for (size_t i = 0; i < parts.size(); ++i) pose[i] = links[parts[i].link] * parts[i].origin;

@@ -37,6 +37,10 @@ struct PlanningSceneParams {
   double environment_margin_m = 0.02;  ///< robot (and held box) must stay this far from the environment
   double self_margin_m = 0.005;        ///< non-adjacent robot links must stay this far apart
   double finger_position_m = 0.0301;   ///< finger joint value used for the finger geometry
+  /// Box (base frame) the tool centre point must stay in: the arm driver's workspace limit, so
+  /// the planner never produces a path the driver refuses. Unbounded by default.
+  Eigen::Vector3d tool_min = Eigen::Vector3d::Constant(-1e9);
+  Eigen::Vector3d tool_max = Eigen::Vector3d::Constant(1e9);
   /// Extra allowed link pairs, beyond adjacent links (parent/child through one joint, looking
   /// through links without geometry) and links that collide at every configuration.
   std::vector<std::pair<std::string, std::string>> allowed_collisions;

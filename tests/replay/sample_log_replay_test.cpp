@@ -66,3 +66,19 @@ TEST(SampleReplay, ChangedParameterIsReported) {
 
 }  // namespace
 }  // namespace bookgrasp
+
+namespace bookgrasp {
+namespace {
+
+// Every registered service builds from its shipped configuration (config/services/<name>.yaml):
+// every key present, valid and read.
+TEST(ShippedConfigs, EveryRegisteredServiceBuildsFromItsDefaultConfig) {
+  const ComponentRegistry reg = project_services();
+  EXPECT_GE(reg.names().size(), 8u);
+  for (const auto& name : reg.names()) {
+    EXPECT_NO_THROW(reg.make(name, "", BOOKGRASP_SOURCE_DIR)) << name;
+  }
+}
+
+}  // namespace
+}  // namespace bookgrasp
