@@ -71,7 +71,7 @@ BENCHMARK(BM_DecodeJpeg90)->Unit(benchmark::kMillisecond);
 void BM_MemqDispatchSmallMessage(benchmark::State& s) {
   bookgrasp::Composition comp;
   const auto cfg = bookgrasp::Config::from_string(
-      "service: {name: e}\nchannels: {input: IN, output: OUT, images: IMG}\n");
+      "service: {name: e, implementation: echo}\nchannels: {input: IN, output: OUT, images: IMG}\n");
   comp.add(std::make_unique<bookgrasp_test::EchoComponent>(cfg));
   bookgrasp::task_status_t m{};
   m.state = "x";

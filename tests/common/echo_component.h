@@ -18,7 +18,7 @@ class EchoComponent : public bookgrasp::Component {
  public:
   /// Reads `channels.input`, `channels.output`, `channels.images` from `root`.
   explicit EchoComponent(const bookgrasp::Config& root)
-      : Component(root.get<std::string>("service.name"), "echo"),
+      : Component(root.get<std::string>("service.name"), root.get<std::string>("service.implementation")),
         output_(root.get<std::string>("channels.output")) {
     subscribe(root.get<std::string>("channels.input"), &EchoComponent::on_status);
     subscribe(root.get<std::string>("channels.images"), &EchoComponent::on_image);
@@ -31,6 +31,7 @@ class EchoComponent : public bookgrasp::Component {
     if (msg.message == "throw") throw std::runtime_error("asked to throw");
     bookgrasp::task_status_t out = msg;
     out.state = "echo:" + msg.state;
+    out.message = implementation();
     publish(output_, out);
   }
   void on_image(const bookgrasp::image_t& img) {
