@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "services/replay/lcm_log.h"
+#include "common/lcm_log.h"
 
 namespace bookgrasp {
 

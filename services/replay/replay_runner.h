@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "common/component.h"
-#include "services/replay/lcm_log.h"
+#include "common/lcm_log.h"
 
 namespace bookgrasp {
 

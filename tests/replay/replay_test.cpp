@@ -5,7 +5,7 @@
 
 #include "common/composition.h"
 #include "services/replay/component_registry.h"
-#include "services/replay/lcm_log.h"
+#include "common/lcm_log.h"
 #include "services/replay/output_diff.h"
 #include "services/replay/replay_runner.h"
 #include "tests/replay/gain_component.h"

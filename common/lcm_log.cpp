@@ -1,4 +1,4 @@
-#include "services/replay/lcm_log.h"
+#include "common/lcm_log.h"
 
 #include <fstream>
 #include <stdexcept>
