@@ -1,0 +1,12 @@
+// marker_detector alone: its tag_pose.h and visual_servo's hand_eye_geometry.h both define CameraIntrinsics.
+#include "services/eval_full/component_factories.h"
+
+#include "services/marker_detector/marker_detector_node.h"
+
+namespace bookgrasp::factories {
+
+std::unique_ptr<Component> marker_detector(const Config& c) {
+  return std::make_unique<MarkerDetectorNode>(MarkerDetectorSettings::from_config(c));
+}
+
+}  // namespace bookgrasp::factories

@@ -1,0 +1,502 @@
+#include "services/eval_full/full_cycle_harness.h"
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+#include <regex>
+#include <sstream>
+#include <stdexcept>
+
+#include <lcm/lcm-cpp.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+#include <yaml-cpp/yaml.h>
+
+#include "bookgrasp/grasp_point_t.hpp"
+#include "bookgrasp/hand_image_t.hpp"
+#include "bookgrasp/marker_detections_t.hpp"
+#include "bookgrasp/servo_status_t.hpp"
+#include "bookgrasp/stripe_features_t.hpp"
+#include "bookgrasp/book_features_hand_t.hpp"
+#include "bookgrasp/plan_result_t.hpp"
+#include "bookgrasp/stereo_frame_t.hpp"
+#include "common/composition.h"
+#include "common/config.h"
+#include "common/image_conversion.h"
+#include "common/pose_conversion.h"
+#include "common/scene/scene.h"
+#include "common/service_host.h"
+#include "services/eval_full/component_factories.h"
+#include "services/sim_world/sim_world_node.h"
+
+namespace bookgrasp {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+/// A service's YAML with some keys replaced; `source` keeps the file's path for messages.
+struct ServiceYaml {
+  std::string path;
+  YAML::Node root;
+  explicit ServiceYaml(const std::string& p) : path(p) {
+    if (!fs::exists(p)) throw std::runtime_error("configuration file " + p + " does not exist");
+    root = YAML::LoadFile(p);
+  }
+  /// Applies the "service:key=value" entries of `overrides` that name `service`.
+  void apply(const std::string& service, const std::vector<std::string>& overrides) {
+    for (const std::string& ov : overrides) {
+      const auto colon = ov.find(':'), eq = ov.find('=');
+      if (colon == std::string::npos || eq == std::string::npos || eq < colon)
+        throw std::runtime_error("override '" + ov + "' is not service:dotted.key=value");
+      if (ov.substr(0, colon) != service) continue;
+      set(ov.substr(colon + 1, eq - colon - 1), YAML::Load(ov.substr(eq + 1)));
+    }
+  }
+  template <typename T>
+  void set(const std::string& dotted, const T& value) {
+    std::vector<std::string> parts;
+    std::stringstream ss(dotted);
+    for (std::string s; std::getline(ss, s, '.');) parts.push_back(s);
+    std::vector<YAML::Node> chain{root};
+    for (size_t i = 0; i + 1 < parts.size(); ++i) {
+      YAML::Node next = chain.back()[parts[i]];
+      if (!next.IsMap()) throw std::runtime_error(path + ": no section '" + parts[i] + "' for override " + dotted);
+      chain.push_back(next);
+    }
+    if (!chain.back()[parts.back()].IsDefined())
+      throw std::runtime_error(path + ": override of unknown key " + dotted);
+    chain.back()[parts.back()] = value;
+  }
+  std::string text() const {
+    YAML::Emitter e;
+    e << root;
+    return e.c_str();
+  }
+  Config config() const { return Config::from_string(text(), path); }
+};
+
+double norm_finite(const double* v) { return std::isfinite(v[0]) && std::isfinite(v[1]) && std::isfinite(v[2]) ? 1 : 0; }
+
+Eigen::Vector3d vec3(const double* v) { return Eigen::Vector3d(v[0], v[1], v[2]); }
+
+std::string fmt(const char* f, double a) {
+  char b[64];
+  std::snprintf(b, sizeof b, f, a);
+  return b;
+}
+
+}  // namespace
+
+struct FullCycleHarness::Impl {
+  FullCycleOptions o;
+  std::chrono::steady_clock::time_point wall0 = std::chrono::steady_clock::now();
+  scene::Scene scene;
+  Composition comp;
+  SimWorldNode* sim = nullptr;
+  std::unique_ptr<Component> coordinator;
+  std::string coordinator_yaml_path;
+  std::string coordinator_yaml;
+  std::unique_ptr<lcm::LogFile> log;
+  int64_t log_events = 0;
+  std::regex log_skip{"STEREO_IMAGES|HAND_IMAGE|BWS_DEBUG_IMAGE"};
+  int64_t t0 = 0;
+  int64_t t = 0;
+  int64_t step_us = 10000;
+  // channels
+  std::string ch_status = "TASK_STATUS", ch_gp = "GRASP_POINT", ch_truth = "SIM_GROUND_TRUTH",
+              ch_stereo = "STEREO_IMAGES", ch_hand = "HAND_IMAGE", ch_plan = "PLAN_RESULT", ch_markers = "MARKERS";
+  std::string marker_roles = "-";
+  std::string ch_servo = "SERVO_STATUS", ch_stripe = "STRIPE_FEATURES_HAND", ch_book = "BOOK_FEATURES_HAND";
+  std::string last_gp_reason, last_servo_line, last_stripe_line, last_book_line;
+  int64_t last_servo_trace = 0;
+  stripe_features_t last_stripe_f{};
+  book_features_hand_t last_book_f{};
+  // observations
+  task_status_t status{};
+  ground_truth_t truth{};
+  stereo_frame_t last_stereo{};
+  hand_image_t last_hand{};
+  bool have_stereo = false, have_hand = false;
+  FullCycleResult res;
+  int snapshot_seq = 0;
+  int target_book_id = -1;
+  bool in_extract = false;
+
+  explicit Impl(const FullCycleOptions& opt) : o(opt) {
+    if (o.source_dir.empty()) throw std::runtime_error("FullCycleOptions.source_dir is empty: give the source tree");
+    if (o.progress_file.empty())
+      throw std::runtime_error("FullCycleOptions.progress_file is empty: give a path for the coordinator's progress");
+    if (!(o.physics_step_s > 0)) throw std::runtime_error("FullCycleOptions.physics_step_s must be > 0");
+    step_us = static_cast<int64_t>(std::llround(o.physics_step_s * 1e6));
+    const std::string cfg = o.source_dir + "/config/services/";
+
+    // sim_world, in external drive.
+    ServiceYaml sim_y(cfg + "sim_world.yaml");
+    std::string scene_file = o.scene_file.empty() ? sim_y.root["scene"]["file"].as<std::string>() : o.scene_file;
+    if (!fs::path(scene_file).is_absolute()) scene_file = o.source_dir + "/" + scene_file;
+    if (!fs::exists(scene_file)) throw std::runtime_error("scene file " + scene_file + " does not exist");
+    scene = scene::load_scene(scene_file, o.seed);
+    sim_y.set("scene.file", scene_file);
+    sim_y.set("scene.seed", static_cast<int64_t>(o.seed));
+    sim_y.set("simulation.drive", std::string("external"));
+    sim = &static_cast<SimWorldNode&>(add(sim_y, factories::sim_world));
+    ch_truth = sim_y.root["channels"]["ground_truth"].as<std::string>();
+
+    ServiceYaml stereo_y(cfg + "stereo_camera.yaml");
+    stereo_y.set("backend", std::string("sim"));
+    stereo_y.set("sim.scene_file", scene_file);
+    stereo_y.set("sim.seed", static_cast<int64_t>(o.seed));
+    if (o.stereo_rate_hz > 0) stereo_y.set("sim.frame_rate_hz", o.stereo_rate_hz);
+    ch_stereo = stereo_y.root["channels"]["output"].as<std::string>();
+    add(stereo_y, factories::stereo_camera);
+
+    ServiceYaml hand_y(cfg + "hand_camera.yaml");
+    hand_y.set("backend", std::string("sim"));
+    hand_y.set("sim.scene_file", scene_file);
+    hand_y.set("sim.seed", static_cast<int64_t>(o.seed));
+    if (o.hand_rate_hz > 0) hand_y.set("sim.frame_rate_hz", o.hand_rate_hz);
+    ch_hand = hand_y.root["channels"]["output"].as<std::string>();
+    add(hand_y, factories::hand_camera);
+
+    add(ServiceYaml(cfg + "marker_detector.yaml"), factories::marker_detector);
+    add(ServiceYaml(cfg + "bws_detector.yaml"),
+        factories::bws_detector);
+    add(ServiceYaml(cfg + "bwh_detector.yaml"),
+        factories::bwh_detector);
+    add(ServiceYaml(cfg + "bswh_detector.yaml"),
+        factories::bswh_detector);
+    add(ServiceYaml(cfg + "visual_servo.yaml"),
+        factories::visual_servo);
+    add(ServiceYaml(cfg + "arbiter.yaml"), factories::arbiter);
+    ServiceYaml plan_y(cfg + "planner.yaml");
+    ch_plan = plan_y.root["channels"]["plan_result"].as<std::string>();
+    add(plan_y, factories::planner);
+    add(ServiceYaml(cfg + "arm_driver.yaml"), factories::arm_driver);
+
+    // The coordinator lives outside the composition's list so it can be destroyed and rebuilt.
+    ServiceYaml coord_y(cfg + "coordinator.yaml");
+    coord_y.set("progress_file", o.progress_file);
+    coord_y.set("user.auto_done_after_s", o.user_done_after_s);
+    ch_status = coord_y.root["channels"]["task_status"].as<std::string>();
+    ch_markers = coord_y.root["channels"]["markers"].as<std::string>();
+    ch_servo = coord_y.root["channels"]["servo_status"].as<std::string>();
+    ch_gp = coord_y.root["channels"]["grasp_point"].as<std::string>();
+    coord_y.apply("coordinator", o.overrides);
+    coordinator_yaml_path = coord_y.path;
+    coordinator_yaml = coord_y.text();
+    if (o.fresh_start) {
+      std::error_code ec;
+      fs::remove(o.progress_file, ec);
+    }
+    if (fs::path(o.progress_file).has_parent_path()) fs::create_directories(fs::path(o.progress_file).parent_path());
+    build_coordinator();
+
+    comp.bus().subscribe(ch_status, &Impl::on_status, this);
+    comp.bus().subscribe(ch_gp, &Impl::on_gp, this);
+    comp.bus().subscribe(ch_truth, &Impl::on_truth, this);
+    comp.bus().subscribe(ch_stereo, &Impl::on_stereo, this);
+    comp.bus().subscribe(ch_hand, &Impl::on_hand, this);
+    comp.bus().subscribe(ch_plan, &Impl::on_plan, this);
+    comp.bus().subscribe(ch_markers, &Impl::on_markers, this);
+    comp.bus().subscribe(ch_servo, &Impl::on_servo, this);
+    comp.bus().subscribe(ch_stripe, &Impl::on_stripe, this);
+    comp.bus().subscribe(ch_book, &Impl::on_book, this);
+    if (!o.log_file.empty()) {
+      if (fs::path(o.log_file).has_parent_path()) fs::create_directories(fs::path(o.log_file).parent_path());
+      log = std::make_unique<lcm::LogFile>(o.log_file, "w");
+      if (!log->good()) throw std::runtime_error("cannot write the LCM log " + o.log_file);
+      comp.bus().subscribe(".*", &Impl::on_any, this);
+    }
+    if (!o.snapshot_dir.empty()) fs::create_directories(o.snapshot_dir);
+
+    // The first outputs (at the epoch) and the initial truth.
+    t0 = sim->world().now_utime();
+    t = t0;
+    sim->advance_to(t);
+    comp.spin();
+    truth = sim->world().model().ground_truth(t);
+    for (const auto& b : truth.books)
+      if (b.place == "upper_shelf") ++res.books_on_upper_shelf;
+  }
+
+  Component& add(ServiceYaml y, const std::function<std::unique_ptr<Component>(const Config&)>& make) {
+    y.apply(fs::path(y.path).stem().string(), o.overrides);
+    const Config c = y.config();
+    c.mark_read("service");
+    std::unique_ptr<Component> component = make(c);
+    c.require_all_read();
+    const ServiceSettings settings = ServiceSettings::from_config(Config::from_string(y.text(), y.path));
+    return comp.add_service(std::move(component), settings, y.text());
+  }
+
+  void build_coordinator() {
+    const Config c = Config::from_string(coordinator_yaml, coordinator_yaml_path);
+    c.mark_read("service");
+    coordinator = factories::coordinator(c);
+    c.require_all_read();
+    coordinator->attach(&comp.bus(), [this] { return comp.now_utime(); });
+  }
+
+  void restart_coordinator() {
+    comp.spin();
+    coordinator->detach();
+    coordinator.reset();
+    trace("coordinator destroyed; rebuilt from " + o.progress_file);
+    build_coordinator();
+  }
+
+  double rel_s(int64_t u) const { return static_cast<double>(u - t0) * 1e-6; }
+
+  void trace(const std::string& line) {
+    const std::string l = fmt("%9.2f ", rel_s(comp.now_utime() > 0 ? comp.now_utime() : t0)) + line;
+    res.trace.push_back(l);
+    if (o.verbose) std::cerr << l << "\n";
+  }
+
+  // ---- bus observers ----
+  void on_any(const lcm::ReceiveBuffer* rbuf, const std::string& channel) {
+    if (!o.log_images && std::regex_match(channel, log_skip)) return;
+    lcm::LogEvent ev;
+    ev.eventnum = log_events++;
+    ev.timestamp = comp.now_utime();
+    ev.channel = channel;
+    ev.datalen = static_cast<int32_t>(rbuf->data_size);
+    ev.data = rbuf->data;
+    log->writeEvent(&ev);
+  }
+
+  void on_truth(const lcm::ReceiveBuffer*, const std::string&, const ground_truth_t* m) { truth = *m; }
+  void on_stereo(const lcm::ReceiveBuffer*, const std::string&, const stereo_frame_t* m) {
+    last_stereo = *m;
+    have_stereo = true;
+  }
+  void on_hand(const lcm::ReceiveBuffer*, const std::string&, const hand_image_t* m) {
+    last_hand = *m;
+    have_hand = true;
+  }
+  void on_markers(const lcm::ReceiveBuffer*, const std::string&, const marker_detections_t* m) {
+    std::string roles;
+    for (const auto& k : m->markers) roles += (roles.empty() ? "" : ",") + (k.role.empty() ? std::to_string(k.id) : k.role);
+    if (roles != marker_roles) trace("MARKERS now: [" + roles + "]");
+    marker_roles = roles;
+  }
+  void on_servo(const lcm::ReceiveBuffer*, const std::string&, const servo_status_t* m) {
+    const std::string line = "SERVO_STATUS " + std::to_string(m->request_id) + " mode " + std::to_string(m->mode) +
+                             " state " + std::to_string(m->state) + ": " + m->message;
+    const bool terminal = m->state != servo_status_t::RUNNING && m->state != servo_status_t::IDLE;
+    if (terminal || (line != last_servo_line && m->utime - last_servo_trace >= 1000000)) {
+      trace(line + fmt(" err_px %.1f", m->error_px[0]) + fmt(" %.1f", m->error_px[1]) + " it " +
+            std::to_string(m->iterations));
+      last_servo_trace = m->utime;
+    }
+    last_servo_line = line;
+  }
+  void on_stripe(const lcm::ReceiveBuffer*, const std::string&, const stripe_features_t* m) {
+    last_stripe_f = *m;
+    const std::string line = std::string("STRIPE_FEATURES found ") + (m->found ? "1" : "0") + " end " +
+                             (m->end_found ? "1" : "0") + " " + m->failure_reason;
+    if (line != last_stripe_line) trace(line + fmt(" end_px %.0f", m->end_px[0]) + fmt(" %.0f", m->end_px[1]));
+    last_stripe_line = line;
+  }
+  void on_book(const lcm::ReceiveBuffer*, const std::string&, const book_features_hand_t* m) {
+    last_book_f = *m;
+    const std::string line = std::string("BOOK_FEATURES found ") + (m->found ? "1" : "0");
+    if (line != last_book_line) trace(line + fmt(" R %.0f", m->r_px[0]) + fmt(" %.0f", m->r_px[1]));
+    last_book_line = line;
+  }
+  void on_plan(const lcm::ReceiveBuffer*, const std::string&, const plan_result_t* m) {
+    res.plan_ms.push_back(m->planning_time_s * 1e3);
+    if (!m->success) trace("PLAN_RESULT " + std::to_string(m->request_id) + " failed: " + m->message);
+  }
+
+  BookRecord& book(int index) {
+    while (static_cast<int>(res.books.size()) <= index) {
+      BookRecord b;
+      b.index = static_cast<int>(res.books.size());
+      b.start_s = rel_s(comp.now_utime());
+      res.books.push_back(b);
+    }
+    return res.books[index];
+  }
+
+  const book_truth_t* truth_book(const ground_truth_t& g, int id) const {
+    for (const auto& b : g.books)
+      if (b.id == id) return &b;
+    return nullptr;
+  }
+
+  /// True P1 of a book in the cart's true grasp frame (X up, Y right, Z into the shelf).
+  Eigen::Vector3d true_grasp(const Eigen::Vector3d& p_base) const {
+    const Eigen::Vector3d c = scene.cart_pose.inverse() * p_base;
+    return Eigen::Vector3d(c.z(), -c.y(), c.x());
+  }
+
+  void on_status(const lcm::ReceiveBuffer*, const std::string&, const task_status_t* m) {
+    const std::string prev = status.state;
+    const int prev_moved = status.books_moved;
+    status = *m;
+    if (m->books_moved > prev_moved) {
+      for (int i = prev_moved; i < m->books_moved; ++i) {
+        BookRecord& b = book(i);
+        b.moved = true;
+        b.end_s = rel_s(m->utime);
+      }
+    }
+    res.books_moved = m->books_moved;
+    if (m->state == prev) return;
+    trace("TASK_STATUS " + prev + " -> " + m->state + " (book " + std::to_string(m->current_book) + ", attempt " +
+          std::to_string(m->attempt) + ", moved " + std::to_string(m->books_moved) + ") " + m->message);
+    const ground_truth_t now_truth = sim->world().model().ground_truth(sim->world().now_utime());
+    if (m->state == "WAIT_P1_CHECK" || m->state == "MOVE_TO_STRIPE_START" || m->state == "MOVE_TO_BWH_START") {
+      BookRecord& b = book(m->current_book);
+      if (b.truth_id < 0) {
+        for (const auto& tb : now_truth.books)
+          if (tb.rightmost && tb.place == "upper_shelf") {
+            b.truth_id = tb.id;
+            b.true_width_m = tb.width_m;
+          }
+      }
+      target_book_id = b.truth_id;
+    }
+    if (m->state == "CLOSE_GRIPPER") {
+      BookRecord& b = book(m->current_book);
+      ++b.grasp_attempts;
+      ++res.grasp_attempts;
+      in_extract = true;
+    }
+    if (in_extract && prev == "EXTRACT") {
+      in_extract = false;
+      BookRecord& b = book(m->current_book);
+      const book_truth_t* tb = truth_book(now_truth, b.truth_id);
+      const bool held = tb && tb->place == "gripper";
+      if (held) {
+        ++b.grasp_successes;
+        ++res.grasp_successes;
+      }
+      trace(std::string("GRASP ") + (held ? "held" : "FAILED") + ": book id " + std::to_string(b.truth_id) +
+            " is " + (tb ? tb->place : std::string("unknown")));
+    } else if (in_extract && m->state != "EXTRACT" && m->state != "CLOSE_GRIPPER") {
+      in_extract = false;  // the close itself failed (nothing grasped); counted as a failed attempt
+      trace("GRASP FAILED at close: " + m->message);
+    }
+    snapshot(m->state);
+  }
+
+  void on_gp(const lcm::ReceiveBuffer*, const std::string&, const grasp_point_t* m) {
+    const std::string word = m->reason.substr(0, m->reason.find_first_of(" :"));
+    if (m->reason != last_gp_reason) trace("GRASP_POINT " + m->reason.substr(0, 200));
+    last_gp_reason = m->reason;
+    if (word == "GRASP" && m->valid) {
+      GraspDecisionRecord d;
+      d.book_index = status.current_book;
+      d.p1_present = norm_finite(m->p1_grasp) > 0;
+      d.p1_grasp = vec3(m->p1_grasp);
+      d.p2_grasp = vec3(m->p2_grasp);
+      d.gp_grasp = vec3(m->gp_grasp);
+      d.p1_valid = m->p1_used;
+      const book_truth_t* tb = truth_book(sim->world().model().ground_truth(sim->world().now_utime()), target_book_id);
+      if (tb) {
+        d.truth_known = true;
+        d.p1_true_grasp = true_grasp(vec3(tb->p1_base));
+      }
+      res.decisions.push_back(d);
+    } else if (word == "BOOK_WIDTH" && m->num_steps > 0) {
+      book(status.current_book).measured_width_m = m->steps[0].value_m;
+    }
+  }
+
+  void snapshot(const std::string& state) {
+    if (o.snapshot_dir.empty()) return;
+    const std::string base = o.snapshot_dir + "/" + fmt("%03.0f", snapshot_seq++) + "_" + state;
+    cv::Mat bgr;
+    if (have_hand) {
+      cv::cvtColor(image_to_mat(last_hand.image), bgr, cv::COLOR_RGB2BGR);
+      if (last_stripe_f.utime == last_hand.utime && last_stripe_f.found) {
+        const double* l = last_stripe_f.centre_line_px;
+        cv::line(bgr, cv::Point2d(l[0], l[1]), cv::Point2d(l[2], l[3]), cv::Scalar(255, 255, 0), 1);
+        if (last_stripe_f.end_found)
+          cv::drawMarker(bgr, cv::Point2d(last_stripe_f.end_px[0], last_stripe_f.end_px[1]), cv::Scalar(255, 255, 0),
+                         cv::MARKER_CROSS, 16, 2);
+      }
+      if (last_book_f.utime == last_hand.utime && last_book_f.found)
+        cv::drawMarker(bgr, cv::Point2d(last_book_f.r_px[0], last_book_f.r_px[1]), cv::Scalar(0, 0, 255),
+                       cv::MARKER_CROSS, 16, 2);
+      cv::imwrite(base + "_hand.png", bgr);
+    }
+    if (have_stereo && (state == "WAIT_P1_CHECK" || state == "MOVE_TO_HOLDER" || state == "WAIT_USER" ||
+                        state == "DONE" || state == "ABORTED" || state == "MOVE_TO_LOWER_SHELF")) {
+      cv::cvtColor(image_to_mat(last_stereo.left), bgr, cv::COLOR_RGB2BGR);
+      cv::imwrite(base + "_stereo.png", bgr);
+    }
+  }
+
+  int64_t last_periodic = 0;
+  void step() {
+    t += step_us;
+    sim->advance_to(t);
+    comp.spin();
+    if (o.snapshot_period_s > 0 && (status.state == "SERVO_STRIPE" || status.state == "SERVO_BOOK") &&
+        t - last_periodic >= static_cast<int64_t>(o.snapshot_period_s * 1e6)) {
+      last_periodic = t;
+      snapshot(status.state + fmt("_t%.1f", rel_s(t)));
+    }
+  }
+
+  FullCycleResult result() const {
+    FullCycleResult r = res;
+    r.final_truth = sim->world().model().ground_truth(sim->world().now_utime());
+    r.sim_s = rel_s(t);
+    r.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+    r.message = status.message;
+    return r;
+  }
+};
+
+FullCycleHarness::FullCycleHarness(const FullCycleOptions& options) : impl_(std::make_unique<Impl>(options)) {}
+FullCycleHarness::~FullCycleHarness() = default;
+
+void FullCycleHarness::step() { impl_->step(); }
+
+std::string FullCycleHarness::run_until(double budget_s, int max_books, const std::function<bool()>& stop) {
+  const int64_t end = impl_->t + static_cast<int64_t>(budget_s * 1e6);
+  while (impl_->t < end) {
+    impl_->step();
+    const std::string& s = impl_->status.state;
+    if (s == "DONE" || s == "ABORTED") return s;
+    if (max_books > 0 && impl_->status.books_moved >= max_books) return "BOOKS";
+    if (stop && stop()) return "STOP";
+  }
+  return "BUDGET";
+}
+
+void FullCycleHarness::restart_coordinator() { impl_->restart_coordinator(); }
+const task_status_t& FullCycleHarness::status() const { return impl_->status; }
+const ground_truth_t& FullCycleHarness::truth() const { return impl_->truth; }
+double FullCycleHarness::sim_time_s() const { return impl_->rel_s(impl_->t); }
+FullCycleResult FullCycleHarness::result() const { return impl_->result(); }
+cv::Mat FullCycleHarness::last_stereo_left() const {
+  return impl_->have_stereo ? image_to_mat(impl_->last_stereo.left).clone() : cv::Mat();
+}
+cv::Mat FullCycleHarness::last_hand_image() const {
+  return impl_->have_hand ? image_to_mat(impl_->last_hand.image).clone() : cv::Mat();
+}
+
+FullCycleResult run_full_cycle(const FullCycleOptions& options, double budget_s, int max_books) {
+  try {
+    FullCycleHarness h(options);
+    const std::string end = h.run_until(budget_s, max_books);
+    FullCycleResult r = h.result();
+    r.end = end;
+    return r;
+  } catch (const std::exception& e) {
+    FullCycleResult r;
+    r.end = "ERROR";
+    r.message = e.what();
+    return r;
+  }
+}
+
+}  // namespace bookgrasp

@@ -1,0 +1,140 @@
+#pragma once
+/// @file
+/// The whole library cycle in one process (common/composition.h, memq://):
+/// sim_world (drive: external), stereo_camera and hand_camera (sim backends),
+/// marker_detector, bws_detector, bwh_detector, bswh_detector, visual_servo,
+/// arbiter, planner, arm_driver and the coordinator, each built from its
+/// config/services/<name>.yaml exactly as its process builds it. Only the keys
+/// that tie them to one scene are overridden (scene file and seed, the
+/// simulation's drive, camera frame rates if asked, the coordinator's progress
+/// file and its demo "done" delay).
+///
+/// The harness steps physics in small steps of simulation time and spins the
+/// bus after each, so every component sees message time only. It watches
+/// TASK_STATUS, GRASP_POINT and SIM_GROUND_TRUTH and turns them into what the
+/// evaluation measures (grasp attempts and their physical outcome, P1-P2
+/// agreement, book width against the truth, cycle time per book). Used by
+/// tests/coordinator/full_cycle_test.cpp and the tool bookgrasp_eval_full.
+
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+#include <opencv2/core.hpp>
+
+#include "bookgrasp/ground_truth_t.hpp"
+#include "bookgrasp/task_status_t.hpp"
+
+namespace bookgrasp {
+
+/// What to run and how.
+struct FullCycleOptions {
+  std::string source_dir;            ///< project source tree (config/services/*.yaml are read from it)
+  std::string scene_file;            ///< scene YAML ("" = the one in sim_world.yaml); relative to source_dir
+  uint64_t seed = 1;                 ///< scene seed (sim_world, both cameras)
+  std::string progress_file;         ///< the coordinator's progress file (required; deleted at start if fresh)
+  bool fresh_start = true;           ///< delete progress_file before building the coordinator
+  double user_done_after_s = 1.0;    ///< coordinator user.auto_done_after_s (the demo's own "done")
+  double stereo_rate_hz = 0;         ///< > 0 overrides stereo_camera sim.frame_rate_hz
+  double hand_rate_hz = 0;           ///< > 0 overrides hand_camera sim.frame_rate_hz
+  double physics_step_s = 0.01;      ///< simulation time per harness step (then the bus is spun)
+  std::string log_file;              ///< "" = no log; else an LCM log of the bus (message time stamps)
+  bool log_images = false;           ///< also log STEREO_IMAGES and HAND_IMAGE (large)
+  std::string snapshot_dir;          ///< "" = none; else PNGs of the stereo/hand images at state changes
+  double snapshot_period_s = 0;      ///< > 0: also a hand snapshot this often while a servo runs
+  bool verbose = false;              ///< trace lines to stderr as they happen
+  /// Extra configuration overrides "service:dotted.key=value" (value parsed as YAML), applied
+  /// after the harness's own; the key must exist in the service's YAML.
+  std::vector<std::string> overrides;
+};
+
+/// One grasp decision of the arbiter (GRASP_POINT "GRASP ...").
+struct GraspDecisionRecord {
+  int book_index = 0;                ///< coordinator's current book
+  bool p1_present = false;           ///< the decision had a P1 from BwS
+  Eigen::Vector3d p1_grasp = Eigen::Vector3d::Zero();  ///< grasp frame, m
+  Eigen::Vector3d p2_grasp = Eigen::Vector3d::Zero();
+  Eigen::Vector3d gp_grasp = Eigen::Vector3d::Zero();
+  Eigen::Vector3d p1_true_grasp = Eigen::Vector3d::Zero();  ///< true P1 of the right-most book, same frame
+  bool truth_known = false;
+  bool p1_valid = false;             ///< the arbiter used P1 (p1_used)
+};
+
+/// One book taken (or tried) by the cycle.
+struct BookRecord {
+  int index = 0;                     ///< order in the cycle (0 = first)
+  int truth_id = -1;                 ///< SIM_GROUND_TRUTH id of the book (right-most at the start of the book)
+  double true_width_m = 0;
+  double measured_width_m = -1;      ///< arbiter BOOK_WIDTH (-1 = none)
+  int grasp_attempts = 0;            ///< CLOSE_GRIPPER entries for this book (from the shelf)
+  int grasp_successes = 0;           ///< ... after which the book was in the gripper (physics)
+  bool moved = false;                ///< completed the whole cycle (on the lower shelf)
+  double start_s = 0;                ///< message time the book's attempt started (s from start)
+  double end_s = -1;                 ///< message time it was counted moved
+};
+
+/// What happened in a run.
+struct FullCycleResult {
+  std::string end;                   ///< DONE, ABORTED, BUDGET, BOOKS (max_books reached), ERROR
+  std::string message;               ///< coordinator's last message or the error
+  int books_on_upper_shelf = 0;      ///< at the start (truth)
+  int books_moved = 0;               ///< coordinator's count
+  int grasp_attempts = 0;
+  int grasp_successes = 0;
+  std::vector<BookRecord> books;
+  std::vector<GraspDecisionRecord> decisions;
+  ground_truth_t final_truth;        ///< latest SIM_GROUND_TRUTH
+  double sim_s = 0;                  ///< simulation time used
+  double wall_s = 0;                 ///< wall time used (incl. building)
+  std::vector<std::string> trace;    ///< TASK_STATUS state changes and arbiter decisions, with times
+  std::vector<double> plan_ms;       ///< planner wall time per PLAN_RESULT (when reported)
+};
+
+/// The composed system of one scene.
+class FullCycleHarness {
+ public:
+  /// Builds every component from its configuration. Throws std::runtime_error
+  /// or ConfigError (message says what) if one cannot be built.
+  explicit FullCycleHarness(const FullCycleOptions& options);
+  ~FullCycleHarness();
+  FullCycleHarness(const FullCycleHarness&) = delete;
+  FullCycleHarness& operator=(const FullCycleHarness&) = delete;
+
+  /// Advances physics by one step and dispatches everything that fell due.
+  void step();
+  /// Steps until `stop()` is true (checked after every step), the coordinator
+  /// is DONE or ABORTED, `max_books` books were moved (0 = no limit), or
+  /// `budget_s` more seconds of simulation time passed. Returns the end word
+  /// (DONE, ABORTED, BOOKS, BUDGET, STOP).
+  std::string run_until(double budget_s, int max_books = 0, const std::function<bool()>& stop = nullptr);
+  /// Destroys the coordinator component and builds a new one from the same
+  /// configuration and progress file (a restarted process).
+  void restart_coordinator();
+
+  /// The latest TASK_STATUS (state "" before the first).
+  const task_status_t& status() const;
+  /// The latest SIM_GROUND_TRUTH.
+  const ground_truth_t& truth() const;
+  /// Simulation time since the start, s.
+  double sim_time_s() const;
+  /// What was measured so far.
+  FullCycleResult result() const;
+  /// The last left stereo and hand images (RGB; empty before the first).
+  cv::Mat last_stereo_left() const;
+  cv::Mat last_hand_image() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+/// Runs one scene: builds the harness, runs until the coordinator is DONE or
+/// ABORTED, `max_books` books were moved (0 = all) or `budget_s` of simulation
+/// time. Never throws: a setup error gives end = "ERROR" with the message.
+FullCycleResult run_full_cycle(const FullCycleOptions& options, double budget_s, int max_books = 0);
+
+}  // namespace bookgrasp

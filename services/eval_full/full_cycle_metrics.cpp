@@ -1,0 +1,178 @@
+#include "services/eval_full/full_cycle_metrics.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <sstream>
+
+namespace bookgrasp {
+
+Stats stats_of(std::vector<double> v) {
+  Stats s;
+  s.n = static_cast<int>(v.size());
+  if (v.empty()) return s;
+  std::sort(v.begin(), v.end());
+  double sum = 0;
+  for (double x : v) sum += x;
+  s.mean = sum / v.size();
+  s.min = v.front();
+  s.max = v.back();
+  const size_t n = v.size();
+  s.median = n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+  s.p95 = v[std::min(n - 1, static_cast<size_t>(std::ceil(0.95 * n)) - 1)];
+  return s;
+}
+
+namespace {
+
+/// The first word of the coordinator message, e.g. "plan" or "servo"; keeps failure classes short.
+std::string first_words(const std::string& msg, int words) {
+  std::istringstream ss(msg);
+  std::string w, out;
+  for (int i = 0; i < words && ss >> w; ++i) out += (i ? " " : "") + w;
+  while (!out.empty() && (out.back() == ':' || out.back() == ',' || out.back() == '.')) out.pop_back();
+  return out;
+}
+
+}  // namespace
+
+std::string failure_reason(const FullCycleResult& r, int max_books) {
+  if (r.end == "ERROR") return "ERROR: " + r.message;
+  if (r.end == "ABORTED") return "ABORTED: " + first_words(r.message, 6);
+  if (r.end == "BUDGET") {
+    const std::string state = r.trace.empty() ? std::string("?") : r.trace.back();
+    std::string last_state = "?";
+    for (auto it = r.trace.rbegin(); it != r.trace.rend(); ++it) {
+      const auto p = it->find("-> ");
+      if (it->find("TASK_STATUS") != std::string::npos && p != std::string::npos) {
+        last_state = it->substr(p + 3, it->find(' ', p + 3) - p - 3);
+        break;
+      }
+    }
+    return "BUDGET: stuck in " + last_state;
+  }
+  if (max_books > 0 && r.books_moved < max_books && r.end != "DONE") return "INCOMPLETE: " + r.end;
+  if (r.end == "DONE") {
+    // Every upper-shelf book should have gone to the lower shelf.
+    int left_upper = 0, elsewhere = 0;
+    for (const auto& b : r.final_truth.books) {
+      if (b.place == "upper_shelf") ++left_upper;
+      if (b.place != "upper_shelf" && b.place != "lower_shelf") ++elsewhere;
+    }
+    if (elsewhere > 0) return "DONE with " + std::to_string(elsewhere) + " book(s) neither on a shelf";
+    if (left_upper > 0) return "DONE with " + std::to_string(left_upper) + " book(s) left on the upper shelf";
+  }
+  for (const auto& b : r.books)
+    if (b.grasp_attempts > b.grasp_successes) return "GRASP_RETRIED: a grasp did not hold the book";
+  return "";
+}
+
+void accumulate(const SceneOutcome& o, int max_books, const MetricTolerances& tol, EvalMetrics* m) {
+  const FullCycleResult& r = o.result;
+  ++m->scenes;
+  m->scene_wall_s.push_back(r.wall_s);
+  const int targeted = max_books > 0 ? std::min(max_books, r.books_on_upper_shelf) : r.books_on_upper_shelf;
+  m->books_targeted += targeted;
+  m->books_moved += std::min(r.books_moved, targeted > 0 ? targeted : r.books_moved);
+  m->grasp_attempts += r.grasp_attempts;
+  m->grasp_successes += r.grasp_successes;
+  for (const auto& d : r.decisions) {
+    if (!d.p1_present) continue;
+    ++m->decisions;
+    const double dy = d.p2_grasp.y() - d.p1_grasp.y(), dx = d.p2_grasp.x() - d.p1_grasp.x();
+    m->p1_p2_dy_mm.push_back(dy * 1e3);
+    m->p1_p2_dx_mm.push_back(dx * 1e3);
+    if (std::abs(dy) <= tol.agreement_y_m && std::abs(dx) <= tol.agreement_x_m) ++m->decisions_agreeing;
+    if (d.truth_known)
+      for (int k = 0; k < 3; ++k) m->p1_error_mm[k].push_back(std::abs(d.p1_grasp[k] - d.p1_true_grasp[k]) * 1e3);
+  }
+  for (const auto& b : r.books) {
+    if (b.measured_width_m >= 0 && b.truth_id >= 0) {
+      ++m->widths;
+      const double e = std::abs(b.measured_width_m - b.true_width_m);
+      m->width_error_mm.push_back(e * 1e3);
+      if (e <= tol.width_m) ++m->widths_within;
+    }
+    if (b.moved && b.end_s >= 0) m->cycle_s.push_back(b.end_s - b.start_s);
+  }
+  for (double p : r.plan_ms) m->plan_ms.push_back(p);
+  const std::string why = failure_reason(r, max_books);
+  if (!why.empty()) {
+    m->failures.emplace_back(o.seed, why);
+    ++m->failure_modes[why];
+  }
+}
+
+namespace {
+
+std::string num(double v) {
+  if (!std::isfinite(v)) return "null";
+  char b[64];
+  std::snprintf(b, sizeof b, "%.6g", v);
+  return b;
+}
+
+std::string rate(int k, int n) { return n > 0 ? num(static_cast<double>(k) / n) : "null"; }
+
+std::string esc(const std::string& s) {
+  std::string o;
+  for (char c : s) {
+    if (c == '"' || c == '\\') o += '\\';
+    if (c == '\n') {
+      o += "\\n";
+      continue;
+    }
+    if (static_cast<unsigned char>(c) < 0x20) continue;
+    o += c;
+  }
+  return o;
+}
+
+std::string stats_json(const Stats& s) {
+  return "{\"n\": " + std::to_string(s.n) + ", \"mean\": " + num(s.mean) + ", \"median\": " + num(s.median) +
+         ", \"p95\": " + num(s.p95) + ", \"max\": " + num(s.max) + "}";
+}
+
+}  // namespace
+
+std::string metrics_json(const EvalMetrics& m, const std::string& command) {
+  std::ostringstream j;
+  j << "{\n";
+  j << "  \"command\": \"" << esc(command) << "\",\n";
+  j << "  \"scenes\": " << m.scenes << ",\n";
+  j << "  \"books_targeted\": " << m.books_targeted << ",\n";
+  j << "  \"books_moved\": " << m.books_moved << ",\n";
+  j << "  \"books_moved_rate\": " << rate(m.books_moved, m.books_targeted) << ",\n";
+  j << "  \"grasp_attempts\": " << m.grasp_attempts << ",\n";
+  j << "  \"grasp_successes\": " << m.grasp_successes << ",\n";
+  j << "  \"grasp_success_rate\": " << rate(m.grasp_successes, m.grasp_attempts) << ",\n";
+  j << "  \"p1_p2_decisions\": " << m.decisions << ",\n";
+  j << "  \"p1_p2_agreement_rate\": " << rate(m.decisions_agreeing, m.decisions) << ",\n";
+  j << "  \"widths_measured\": " << m.widths << ",\n";
+  j << "  \"width_within_1cm_rate\": " << rate(m.widths_within, m.widths) << ",\n";
+  j << "  \"width_error_mm\": " << stats_json(stats_of(m.width_error_mm)) << ",\n";
+  j << "  \"p1_error_mm\": {\"x\": " << stats_json(stats_of(m.p1_error_mm[0]))
+    << ", \"y\": " << stats_json(stats_of(m.p1_error_mm[1])) << ", \"z\": " << stats_json(stats_of(m.p1_error_mm[2]))
+    << "},\n";
+  j << "  \"cycle_s\": " << stats_json(stats_of(m.cycle_s)) << ",\n";
+  j << "  \"planning_ms\": " << stats_json(stats_of(m.plan_ms)) << ",\n";
+  j << "  \"scene_wall_s\": " << stats_json(stats_of(m.scene_wall_s)) << ",\n";
+  j << "  \"failure_modes\": {";
+  bool first = true;
+  for (const auto& [k, v] : m.failure_modes) {
+    j << (first ? "" : ", ") << "\"" << esc(k) << "\": " << v;
+    first = false;
+  }
+  j << "},\n";
+  j << "  \"failures\": [";
+  first = true;
+  for (const auto& [seed, why] : m.failures) {
+    j << (first ? "\n" : ",\n") << "    {\"seed\": " << seed << ", \"reason\": \"" << esc(why) << "\"}";
+    first = false;
+  }
+  j << (m.failures.empty() ? "]\n" : "\n  ]\n");
+  j << "}\n";
+  return j.str();
+}
+
+}  // namespace bookgrasp

@@ -1,0 +1,67 @@
+#pragma once
+/// @file
+/// The evaluation's figures over many scenes run by the full-cycle harness
+/// (paper Section 5): grasp success, P1-P2 agreement, book width error, P1
+/// error, cycle and planning time, failures by seed and reason.
+
+#include <cstdint>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "services/eval_full/full_cycle_harness.h"
+
+namespace bookgrasp {
+
+/// One scene's outcome as the evaluation keeps it.
+struct SceneOutcome {
+  uint64_t seed = 0;
+  FullCycleResult result;
+};
+
+/// Tolerances the rates are measured with (paper Section 4.1 and 5).
+struct MetricTolerances {
+  double agreement_y_m = 0.015;  ///< P1-P2 agreement in Y (grasping tolerance)
+  double agreement_x_m = 0.020;  ///< ... in X
+  double width_m = 0.010;        ///< book width within this of the truth
+};
+
+/// Summary statistics of a sample.
+struct Stats {
+  int n = 0;
+  double mean = 0, median = 0, max = 0, min = 0, p95 = 0;
+};
+/// Statistics of `v` (all zero when empty).
+Stats stats_of(std::vector<double> v);
+
+/// Everything metrics.json carries.
+struct EvalMetrics {
+  int scenes = 0;
+  int books_targeted = 0;                    ///< books the cycle was asked to move (per scene: max_books or all)
+  int books_moved = 0;
+  int grasp_attempts = 0;
+  int grasp_successes = 0;
+  int decisions = 0;                         ///< GRASP decisions with a P1
+  int decisions_agreeing = 0;
+  int widths = 0;                            ///< books with a measured width
+  int widths_within = 0;
+  std::vector<double> width_error_mm;        ///< |measured - true| per book
+  std::vector<double> p1_error_mm[3];        ///< |P1 - true P1| per grasp-frame axis (X, Y, Z)
+  std::vector<double> p1_p2_dy_mm, p1_p2_dx_mm;  ///< P2 - P1 per decision
+  std::vector<double> cycle_s;               ///< per moved book, message time
+  std::vector<double> plan_ms;               ///< planner time per request
+  std::vector<double> scene_wall_s;          ///< wall time per scene
+  std::vector<std::pair<uint64_t, std::string>> failures;  ///< seed, reason
+  std::map<std::string, int> failure_modes;  ///< reason class -> count
+};
+
+/// The failure class of a scene ("" = none): ERROR, ABORTED: <state>, BUDGET in <state>, GRASP_SLIPPED, ...
+std::string failure_reason(const FullCycleResult& r, int max_books);
+
+/// Accumulates `outcome` into `m` (max_books as given to the harness, 0 = all books).
+void accumulate(const SceneOutcome& outcome, int max_books, const MetricTolerances& tol, EvalMetrics* m);
+
+/// metrics.json text.
+std::string metrics_json(const EvalMetrics& m, const std::string& command);
+
+}  // namespace bookgrasp
