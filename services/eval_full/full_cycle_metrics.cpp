@@ -62,8 +62,7 @@ std::string failure_reason(const FullCycleResult& r, int max_books) {
     if (elsewhere > 0) return "DONE with " + std::to_string(elsewhere) + " book(s) neither on a shelf";
     if (left_upper > 0) return "DONE with " + std::to_string(left_upper) + " book(s) left on the upper shelf";
   }
-  for (const auto& b : r.books)
-    if (b.grasp_attempts > b.grasp_successes) return "GRASP_RETRIED: a grasp did not hold the book";
+  if (r.grasp_attempts > r.grasp_successes) return "GRASP_RETRIED: a grasp did not hold the book";
   return "";
 }
 

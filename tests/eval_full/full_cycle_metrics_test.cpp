@@ -1,0 +1,121 @@
+// The evaluation's arithmetic (services/eval_full/full_cycle_metrics.h) on hand-made scene outcomes whose
+// figures are worked out by hand in the comments.
+#include <gtest/gtest.h>
+
+#include "services/eval_full/full_cycle_metrics.h"
+
+using namespace bookgrasp;
+
+namespace {
+
+book_truth_t truth_book(const std::string& place) {
+  book_truth_t b{};
+  b.place = place;
+  return b;
+}
+
+SceneOutcome done_scene(uint64_t seed) {
+  SceneOutcome o;
+  o.seed = seed;
+  FullCycleResult& r = o.result;
+  r.end = "DONE";
+  r.books_on_upper_shelf = 2;
+  r.books_moved = 2;
+  r.grasp_attempts = 3;   // one retry
+  r.grasp_successes = 2;
+  r.final_truth.books = {truth_book("lower_shelf"), truth_book("lower_shelf")};
+  r.final_truth.num_books = 2;
+  BookRecord a;
+  a.truth_id = 0;
+  a.true_width_m = 0.020;
+  a.measured_width_m = 0.023;  // 3 mm
+  a.moved = true;
+  a.start_s = 0;
+  a.end_s = 100;
+  BookRecord b = a;
+  b.truth_id = 1;
+  b.measured_width_m = 0.035;  // 15 mm: outside 1 cm
+  b.start_s = 100;
+  b.end_s = 220;
+  r.books = {a, b};
+  GraspDecisionRecord d;
+  d.p1_present = true;
+  d.p1_grasp = {0.20, 0.10, 0.01};
+  d.p2_grasp = {0.21, 0.11, 0.01};  // dY 10 mm, dX 10 mm: agree
+  d.truth_known = true;
+  d.p1_true_grasp = {0.204, 0.10, 0.013};
+  GraspDecisionRecord e = d;
+  e.p2_grasp = {0.20, 0.12, 0.01};  // dY 20 mm: disagree
+  GraspDecisionRecord no_p1;
+  no_p1.p1_present = false;
+  r.decisions = {d, e, no_p1};
+  return o;
+}
+
+}  // namespace
+
+TEST(FullCycleMetrics, StatsOfASample) {
+  const Stats s = stats_of({4, 1, 3, 2});
+  EXPECT_EQ(s.n, 4);
+  EXPECT_DOUBLE_EQ(s.mean, 2.5);
+  EXPECT_DOUBLE_EQ(s.median, 2.5);
+  EXPECT_DOUBLE_EQ(s.max, 4);
+  EXPECT_DOUBLE_EQ(s.min, 1);
+  EXPECT_EQ(stats_of({}).n, 0);
+}
+
+TEST(FullCycleMetrics, AccumulatesRatesAndErrors) {
+  EvalMetrics m;
+  accumulate(done_scene(7), 0, MetricTolerances{}, &m);
+  EXPECT_EQ(m.scenes, 1);
+  EXPECT_EQ(m.books_targeted, 2);
+  EXPECT_EQ(m.books_moved, 2);
+  EXPECT_EQ(m.grasp_attempts, 3);
+  EXPECT_EQ(m.grasp_successes, 2);
+  EXPECT_EQ(m.decisions, 2);           // the decision without P1 is not an agreement sample
+  EXPECT_EQ(m.decisions_agreeing, 1);
+  EXPECT_EQ(m.widths, 2);
+  EXPECT_EQ(m.widths_within, 1);
+  ASSERT_EQ(m.width_error_mm.size(), 2u);
+  EXPECT_NEAR(m.width_error_mm[0], 3.0, 1e-9);
+  EXPECT_NEAR(m.width_error_mm[1], 15.0, 1e-9);
+  ASSERT_EQ(m.p1_error_mm[0].size(), 2u);
+  EXPECT_NEAR(m.p1_error_mm[0][0], 4.0, 1e-9);
+  EXPECT_NEAR(m.p1_error_mm[2][0], 3.0, 1e-9);
+  ASSERT_EQ(m.cycle_s.size(), 2u);
+  EXPECT_DOUBLE_EQ(m.cycle_s[1], 120);
+  // A retried grasp is a failure mode of its own, listed with the seed.
+  ASSERT_EQ(m.failures.size(), 1u);
+  EXPECT_EQ(m.failures[0].first, 7u);
+  EXPECT_NE(m.failures[0].second.find("GRASP_RETRIED"), std::string::npos);
+}
+
+TEST(FullCycleMetrics, FailureReasons) {
+  FullCycleResult r;
+  r.end = "ERROR";
+  r.message = "scene file x does not exist";
+  EXPECT_EQ(failure_reason(r, 1), "ERROR: scene file x does not exist");
+  r.end = "BUDGET";
+  r.trace = {"  1.00 TASK_STATUS PARK -> SERVO_STRIPE (book 0) x", "  2.00 GRASP_POINT NEED_PS"};
+  EXPECT_EQ(failure_reason(r, 1), "BUDGET: stuck in SERVO_STRIPE");
+  r.end = "ABORTED";
+  r.message = "aborted in SERVO_STRIPE: book 0: 3 attempts failed";
+  EXPECT_EQ(failure_reason(r, 1), "ABORTED: aborted in SERVO_STRIPE: book 0: 3");
+  r.end = "DONE";
+  r.message.clear();
+  r.final_truth.books = {truth_book("lower_shelf"), truth_book("other")};
+  EXPECT_EQ(failure_reason(r, 0), "DONE with 1 book(s) neither on a shelf");
+  r.final_truth.books = {truth_book("lower_shelf"), truth_book("lower_shelf")};
+  EXPECT_EQ(failure_reason(r, 0), "");
+}
+
+TEST(FullCycleMetrics, JsonCarriesTheRequiredKeys) {
+  EvalMetrics m;
+  accumulate(done_scene(3), 0, MetricTolerances{}, &m);
+  const std::string j = metrics_json(m, "bookgrasp_eval_full --scenes 1 --seed 3 --out x");
+  for (const char* key : {"\"scenes\": 1", "\"grasp_attempts\": 3", "\"grasp_success_rate\": 0.666667",
+                          "\"books_moved_rate\": 1", "\"p1_p2_agreement_rate\": 0.5", "\"width_within_1cm_rate\": 0.5",
+                          "\"width_error_mm\": {\"n\": 2, \"mean\": 9", "\"max\": 15", "\"cycle_s\": {\"n\": 2, \"mean\": 110, \"median\": 110",
+                          "\"failures\": [", "{\"seed\": 3, \"reason\": \"GRASP_RETRIED"})
+    EXPECT_NE(j.find(key), std::string::npos) << key << " missing in\n" << j;
+}
