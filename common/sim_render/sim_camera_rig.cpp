@@ -114,4 +114,28 @@ CameraImage SimCameraRig::capture(const std::string& name, int64_t utime, bool w
   return out;
 }
 
+Admission admit_sim_state(const sim_state_t& state, uint64_t rig_seed, TimeOrderGuard& order,
+                          CaptureSchedule& schedule) {
+  Admission a;
+  a.reason = check_sim_state(state);
+  if (!a.reason.empty()) return a;
+  if (static_cast<uint64_t>(state.seed) != rig_seed) {
+    a.reason = "SIM_STATE is of seed " + std::to_string(state.seed) + " but this camera renders seed " +
+               std::to_string(rig_seed) + " (set sim.seed to the simulation's seed)";
+    return a;
+  }
+  const TimeOrder verdict = order.check(state.utime);
+  if (verdict == TimeOrder::kStale) {
+    a.reason = "SIM_STATE " + order.describe(state.utime, verdict);
+    return a;
+  }
+  if (verdict == TimeOrder::kRestarted) {
+    a.restarted = true;
+    a.reason = "SIM_STATE " + order.describe(state.utime, verdict);
+    schedule = CaptureSchedule(1e6 / static_cast<double>(schedule.period_us()));
+  }
+  a.render = schedule.due(state.utime);
+  return a;
+}
+
 }  // namespace bookgrasp::sim_render

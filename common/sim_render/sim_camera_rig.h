@@ -11,6 +11,8 @@
 #include <opencv2/core.hpp>
 
 #include "bookgrasp/sim_state_t.hpp"
+#include "common/sim_render/capture_schedule.h"
+#include "common/time_order.h"
 #include "common/scene/scene.h"
 #include "common/scene/sim_model.h"
 #include "common/sim_render/offscreen_renderer.h"
@@ -72,5 +74,18 @@ class SimCameraRig {
 /// are finite, quaternions are not zero. Returns "" if fine, otherwise the
 /// reason.
 std::string check_sim_state(const sim_state_t& state);
+
+/// Whether a camera renders a SIM_STATE.
+struct Admission {
+  bool render = false;     ///< a frame is due: render it
+  bool restarted = false;  ///< the simulation restarted (its clock jumped back): schedule reset; not an error
+  std::string reason;      ///< why not rendered (bad state), or what the restart was
+};
+
+/// The one gate every simulated camera puts a SIM_STATE through: content (check_sim_state), the
+/// scene seed (`rig_seed`), time order (`order`: out-of-order states are refused, a restarted
+/// simulation is followed) and the frame schedule (`schedule`, reset on a restart).
+Admission admit_sim_state(const sim_state_t& state, uint64_t rig_seed, TimeOrderGuard& order,
+                          CaptureSchedule& schedule);
 
 }  // namespace bookgrasp::sim_render

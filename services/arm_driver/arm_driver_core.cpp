@@ -31,6 +31,17 @@ void ArmDriverCore::on_measurement(int64_t now_utime, const Eigen::VectorXd& q, 
   if (gripper_width_ < 0) gripper_width_ = gripper_width;
 }
 
+void ArmDriverCore::restart(int64_t now_utime, const Eigen::VectorXd& q, double gripper_width) {
+  now_ = now_utime;
+  last_update_ = -1;
+  last_heard_ = now_utime;
+  q_measured_ = q;
+  q_cmd_ = q;
+  qd_cmd_ = Eigen::VectorXd::Zero(q.size());
+  gripper_width_ = gripper_width;
+  stop("the arm's source restarted (simulation reset): motion stopped, holding the new position");
+}
+
 std::string ArmDriverCore::command_trajectory(const JointTrajectory& traj, int64_t id) {
   if (!initialised()) return "no measurement of the arm yet (waiting for SIM_STATE)";
   const std::string why = validate_trajectory(traj, q_cmd_, limits_, [this](const Eigen::VectorXd& q) {

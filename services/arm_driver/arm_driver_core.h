@@ -47,6 +47,11 @@ class ArmDriverCore {
   /// The first one initialises the setpoint to where the arm is.
   void on_measurement(int64_t now_utime, const Eigen::VectorXd& q, double gripper_width);
 
+  /// The arm's source restarted (a restarted simulation: its clock jumped back and the arm is
+  /// somewhere else): any motion stops (state STOPPED, with the reason) and the setpoint becomes
+  /// the new measurement, so the arm is never pulled back to where the old world had it.
+  void restart(int64_t now_utime, const Eigen::VectorXd& q, double gripper_width);
+
   /// Executes `traj` from now. Returns "" if accepted, else why not (nothing changes then).
   std::string command_trajectory(const JointTrajectory& traj, int64_t command_id);
   /// Moves the TCP with `twist` (vx vy vz wx wy wz) in `frame` ("base" or "gripper"). "" if accepted.

@@ -97,13 +97,20 @@ void ArmDriverNode::on_sim_state(const sim_state_t& msg) {
     qd[j] = msg.joint_velocities[found];
   }
   if (!q.allFinite() || !std::isfinite(msg.gripper_width_m)) throw std::invalid_argument("SIM_STATE has NaN joints");
-  if (msg.utime < last_measure_utime_) throw std::invalid_argument("SIM_STATE older than the previous one");
+  const TimeOrder order = measure_order_.check(msg.utime);
+  if (order == TimeOrder::kStale) throw std::invalid_argument("SIM_STATE " + measure_order_.describe(msg.utime, order));
   last_measure_utime_ = msg.utime;
   q_ = q;
   qd_ = qd;
   gripper_width_ = msg.gripper_width_m;
   gripper_contact_ = msg.gripper_contact;
-  core_.on_measurement(msg.utime, q, msg.gripper_width_m);
+  if (order == TimeOrder::kRestarted) {
+    report_error("SIM_STATE " + measure_order_.describe(msg.utime, order));
+    core_.restart(msg.utime, q, msg.gripper_width_m);
+    last_setpoint_utime_ = -1;
+  } else {
+    core_.on_measurement(msg.utime, q, msg.gripper_width_m);
+  }
   if (last_setpoint_utime_ >= 0 && (msg.utime - last_setpoint_utime_) * 1e-6 < setpoint_period_s_ - 1e-9) return;
   last_setpoint_utime_ = msg.utime;
   const DriverSetpoint sp = core_.update(msg.utime);

@@ -13,6 +13,7 @@
 #include "bookgrasp/sim_state_t.hpp"
 #include "common/component.h"
 #include "common/config.h"
+#include "common/time_order.h"
 #include "services/arm_driver/arm_driver_core.h"
 
 namespace bookgrasp {
@@ -39,6 +40,7 @@ class ArmDriverNode : public Component {
   double setpoint_period_s_;
   int64_t last_setpoint_utime_ = -1;
   int64_t last_measure_utime_ = 0;
+  TimeOrderGuard measure_order_;
   Eigen::VectorXd q_, qd_;
   double gripper_width_ = 0;
   bool gripper_contact_ = false;

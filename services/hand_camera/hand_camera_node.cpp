@@ -85,23 +85,14 @@ bool HandCameraNode::capture_sim(const sim_state_t& state, hand_image_t* out, st
     *reason = "not the sim backend";
     return false;
   }
-  if (state.utime <= last_state_utime_) {
-    *reason = "SIM_STATE utime " + std::to_string(state.utime) + " is not after the previous " +
-              std::to_string(last_state_utime_) + " (out of order or a restarted simulation: restart the camera)";
+  const sim_render::Admission a = sim_render::admit_sim_state(state, rig_->seed(), order_, *schedule_);
+  if (a.restarted) {
+    report_error(a.reason);  // followed, not rejected
+  } else if (!a.reason.empty()) {
+    *reason = a.reason;
     return false;
   }
-  const std::string problem = sim_render::check_sim_state(state);
-  if (!problem.empty()) {
-    *reason = problem;
-    return false;
-  }
-  if (static_cast<uint64_t>(state.seed) != rig_->seed()) {
-    *reason = "SIM_STATE is of seed " + std::to_string(state.seed) + " but this camera renders seed " +
-              std::to_string(rig_->seed()) + " (set sim.seed to the simulation's seed)";
-    return false;
-  }
-  last_state_utime_ = state.utime;
-  if (!schedule_->due(state.utime)) return false;
+  if (!a.render) return false;
   rig_->apply(state);
   const sim_render::CameraImage img = rig_->capture("hand_camera", state.utime);
   *out = make_hand_image(img.rgb, img.camera.to_message(state.utime), state.utime, sequence_++,

@@ -18,6 +18,7 @@
 #include "bookgrasp/hand_image_t.hpp"
 #include "bookgrasp/sim_state_t.hpp"
 #include "common/component.h"
+#include "common/time_order.h"
 #include "common/config.h"
 #include "common/sim_render/capture_schedule.h"
 
@@ -79,7 +80,7 @@ class HandCameraNode : public Component {
   int64_t sequence_ = 0;
   std::unique_ptr<sim_render::SimCameraRig> rig_;
   std::unique_ptr<sim_render::CaptureSchedule> schedule_;
-  int64_t last_state_utime_ = INT64_MIN;
+  TimeOrderGuard order_;
   std::vector<std::string> images_;
   camera_calibration_t calibration_;
   int64_t frame_index_ = 0;

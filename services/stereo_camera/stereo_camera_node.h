@@ -17,6 +17,7 @@
 #include "bookgrasp/sim_state_t.hpp"
 #include "bookgrasp/stereo_frame_t.hpp"
 #include "common/component.h"
+#include "common/time_order.h"
 #include "common/config.h"
 #include "common/sim_render/calibration_file.h"
 #include "common/sim_render/capture_schedule.h"
@@ -89,7 +90,7 @@ class StereoCameraNode : public Component {
   // sim
   std::unique_ptr<sim_render::SimCameraRig> rig_;
   std::unique_ptr<sim_render::CaptureSchedule> schedule_;
-  int64_t last_state_utime_ = INT64_MIN;
+  TimeOrderGuard order_;
   // files
   std::vector<sim_render::ImagePairFiles> pairs_;
   sim_render::StereoCalibration calibration_;

@@ -166,3 +166,31 @@ TEST(ArmDriverCore, CartesianMotionStopsAtTheWorkspaceBoundary) {
 
 }  // namespace
 }  // namespace bookgrasp
+
+namespace bookgrasp {
+namespace {
+
+TEST(ArmDriverCore, RestartOfTheSourceStopsMotionAndHoldsTheNewPosition) {
+  ArmDriverCore d = make_core();
+  d.on_measurement(kT0, home(), 0.06);
+  Eigen::VectorXd goal = home();
+  goal[0] += 0.5;
+  ASSERT_EQ(d.command_trajectory(move(home(), goal, 2.0), 1), "");
+  d.heartbeat();
+  d.update(kT0 + 500000);
+  Eigen::VectorXd reset_pose(7);  // the simulation's folded start pose
+  reset_pose << 0, -M_PI / 2, 0, -M_PI / 2, 0, -M_PI / 2, 0;
+  d.restart(1000, reset_pose, 0.06);  // the simulation starts again at its epoch
+  EXPECT_EQ(d.state(), DriverState::kStopped);
+  EXPECT_NE(d.message().find("restarted"), std::string::npos);
+  const DriverSetpoint sp = d.update(11000);
+  EXPECT_EQ(sp.q, reset_pose) << "the setpoint is where the arm now is, not where the old world had it";
+  EXPECT_EQ(sp.qd.norm(), 0.0);
+  // Commands work again from the new position.
+  Eigen::VectorXd g2 = reset_pose;
+  g2[0] = 0.2;
+  EXPECT_EQ(d.command_trajectory(move(reset_pose, g2, 1.0), 2), "");
+}
+
+}  // namespace
+}  // namespace bookgrasp
