@@ -434,6 +434,7 @@ struct FullCycleHarness::Impl {
   }
 
   int64_t last_periodic = 0;
+  std::string last_end;
   void step() {
     t += step_us;
     sim->advance_to(t);
@@ -451,6 +452,7 @@ struct FullCycleHarness::Impl {
     r.sim_s = rel_s(t);
     r.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
     r.message = status.message;
+    r.end = last_end;
     return r;
   }
 };
@@ -462,14 +464,16 @@ void FullCycleHarness::step() { impl_->step(); }
 
 std::string FullCycleHarness::run_until(double budget_s, int max_books, const std::function<bool()>& stop) {
   const int64_t end = impl_->t + static_cast<int64_t>(budget_s * 1e6);
+  std::string& word = impl_->last_end;
+  word = "BUDGET";
   while (impl_->t < end) {
     impl_->step();
     const std::string& s = impl_->status.state;
-    if (s == "DONE" || s == "ABORTED") return s;
-    if (max_books > 0 && impl_->status.books_moved >= max_books) return "BOOKS";
-    if (stop && stop()) return "STOP";
+    if (s == "DONE" || s == "ABORTED") return word = s;
+    if (max_books > 0 && impl_->status.books_moved >= max_books) return word = "BOOKS";
+    if (stop && stop()) return word = "STOP";
   }
-  return "BUDGET";
+  return word;
 }
 
 void FullCycleHarness::restart_coordinator() { impl_->restart_coordinator(); }

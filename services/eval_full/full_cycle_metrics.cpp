@@ -38,7 +38,16 @@ std::string first_words(const std::string& msg, int words) {
 
 std::string failure_reason(const FullCycleResult& r, int max_books) {
   if (r.end == "ERROR") return "ERROR: " + r.message;
-  if (r.end == "ABORTED") return "ABORTED: " + first_words(r.message, 6);
+  if (r.end == "ABORTED") {
+    // "aborted in STATE: book 0: 3 attempts failed (...), last: <cause>": class = state + cause.
+    const auto in = r.message.find("aborted in ");
+    const std::string state = in == std::string::npos ? "?" : first_words(r.message.substr(in + 11), 1);
+    const auto last = r.message.find("last: ");
+    std::string cause = last == std::string::npos ? r.message : r.message.substr(last + 6);
+    cause = cause.substr(0, cause.find(" within"));   // drop run-specific numbers
+    cause = cause.substr(0, cause.find(" after "));
+    return "ABORTED in " + state + ": " + first_words(cause, 16);
+  }
   if (r.end == "BUDGET") {
     const std::string state = r.trace.empty() ? std::string("?") : r.trace.back();
     std::string last_state = "?";

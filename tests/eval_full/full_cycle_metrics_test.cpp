@@ -99,8 +99,9 @@ TEST(FullCycleMetrics, FailureReasons) {
   r.trace = {"  1.00 TASK_STATUS PARK -> SERVO_STRIPE (book 0) x", "  2.00 GRASP_POINT NEED_PS"};
   EXPECT_EQ(failure_reason(r, 1), "BUDGET: stuck in SERVO_STRIPE");
   r.end = "ABORTED";
-  r.message = "aborted in SERVO_STRIPE: book 0: 3 attempts failed";
-  EXPECT_EQ(failure_reason(r, 1), "ABORTED: aborted in SERVO_STRIPE: book 0: 3");
+  r.message = "aborted in SERVO_STRIPE: book 0: 3 attempts failed (retries.max_attempts_per_book), last: stripe servo "
+              "ended TIMEOUT: no convergence within 30.00 s (message time) after 289 iterations";
+  EXPECT_EQ(failure_reason(r, 1), "ABORTED in SERVO_STRIPE: stripe servo ended TIMEOUT: no convergence");
   r.end = "DONE";
   r.message.clear();
   r.final_truth.books = {truth_book("lower_shelf"), truth_book("other")};
