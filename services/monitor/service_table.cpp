@@ -51,7 +51,7 @@ std::string channels(const std::vector<channel_stats_t>& list, double* max_age) 
 std::string ServiceTable::render(int64_t now_utime, double stale_s) const {
   std::ostringstream o;
   char line[512];
-  std::snprintf(line, sizeof(line), "%-18s %-10s %-9s %7s %8s %6s %8s %5s %4s  %s\n", "SERVICE", "IMPL", "STATE", "PID",
+  std::snprintf(line, sizeof(line), "%-18s %-18s %-9s %7s %8s %6s %8s %5s %4s  %s\n", "SERVICE", "IMPL", "STATE", "PID",
                 "UPTIME", "AGE", "DATA_AGE", "REJ", "RST", "INPUTS | OUTPUTS | LAST ERROR");
   o << line;
   for (const auto& [name, row] : rows_) {
@@ -64,7 +64,7 @@ std::string ServiceTable::render(int64_t now_utime, double stale_s) const {
     char data_age_s[32];
     if (data_age < 0) std::snprintf(data_age_s, sizeof(data_age_s), "-");
     else std::snprintf(data_age_s, sizeof(data_age_s), "%.1fs", data_age);
-    std::snprintf(line, sizeof(line), "%-18s %-10s %-9s %7d %7.0fs %5.1fs %8s %5lld %4d  ", name.c_str(),
+    std::snprintf(line, sizeof(line), "%-18s %-18.18s %-9s %7d %7.0fs %5.1fs %8s %5lld %4d  ", name.c_str(),
                   row.last.implementation.c_str(), state.c_str(), row.last.pid, row.last.uptime_s, age, data_age_s,
                   static_cast<long long>(row.last.rejected_total), row.restarts);
     o << line << in << " | " << out << " | " << (row.last.last_error.empty() ? "-" : row.last.last_error) << "\n";
