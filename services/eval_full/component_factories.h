@@ -2,7 +2,7 @@
 /// @file
 /// Builds each service's component from its configuration, exactly as its main() does.
 /// (Kept out of full_cycle_harness.cpp: marker_detector and visual_servo both define
-/// bookgrasp::CameraIntrinsics, so their headers cannot share a translation unit.)
+/// bookgrasp::CameraIntrinsics (now renamed TagCameraIntrinsics in marker_detector), so their headers could not share a translation unit.)
 
 #include <memory>
 

@@ -39,7 +39,7 @@ MarkerDetectorSettings MarkerDetectorSettings::from_config(const Config& root) {
 }
 
 bool intrinsics_from_calibration(const camera_calibration_t& c, int image_width, int image_height,
-                                 CameraIntrinsics* k, std::string* reason) {
+                                 TagCameraIntrinsics* k, std::string* reason) {
   if (!std::isfinite(c.fx) || !std::isfinite(c.fy) || !std::isfinite(c.cx) || !std::isfinite(c.cy)) {
     *reason = "calibration has a non-finite fx, fy, cx or cy";
     return false;
@@ -115,7 +115,7 @@ bool MarkerDetectorNode::process(const stereo_frame_t& frame, marker_detections_
               " is not an intensity image (send GRAY8, RGB8, PNG or JPEG)";
     return false;
   }
-  CameraIntrinsics k;
+  TagCameraIntrinsics k;
   if (!intrinsics_from_calibration(frame.left_calibration, gray.cols, gray.rows, &k, reason)) {
     *reason = "left " + *reason;
     return false;

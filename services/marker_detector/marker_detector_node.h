@@ -40,7 +40,7 @@ struct MarkerDetectorSettings {
 /// false and says what is wrong in `reason` (NaN, non-positive focal length,
 /// unknown distortion model, wrong coefficient count, size mismatch).
 bool intrinsics_from_calibration(const camera_calibration_t& calib, int image_width, int image_height,
-                                 CameraIntrinsics* intrinsics, std::string* reason);
+                                 TagCameraIntrinsics* intrinsics, std::string* reason);
 
 /// The AprilTag marker detector as a component.
 class MarkerDetectorNode : public Component {

@@ -14,16 +14,16 @@ std::vector<cv::Point3d> tag_object_points(double s) {
   return {{-h, h, 0.0}, {h, h, 0.0}, {h, -h, 0.0}, {-h, -h, 0.0}};
 }
 
-cv::Mat camera_matrix(const CameraIntrinsics& k) {
+cv::Mat camera_matrix(const TagCameraIntrinsics& k) {
   return (cv::Mat_<double>(3, 3) << k.fx, 0.0, k.cx, 0.0, k.fy, k.cy, 0.0, 0.0, 1.0);
 }
 
-cv::Mat distortion_vector(const CameraIntrinsics& k) {
+cv::Mat distortion_vector(const TagCameraIntrinsics& k) {
   if (k.distortion.empty()) return cv::Mat();
   return cv::Mat(k.distortion, true).reshape(1, 1);
 }
 
-void check_intrinsics(const CameraIntrinsics& k) {
+void check_intrinsics(const TagCameraIntrinsics& k) {
   const bool finite = std::isfinite(k.fx) && std::isfinite(k.fy) && std::isfinite(k.cx) && std::isfinite(k.cy);
   if (!finite || k.fx <= 0.0 || k.fy <= 0.0) {
     throw std::invalid_argument("camera intrinsics must be finite with fx, fy > 0");
@@ -36,7 +36,7 @@ void check_intrinsics(const CameraIntrinsics& k) {
 }  // namespace
 
 TagPose estimate_tag_pose(const std::array<cv::Point2d, 4>& corners, double tag_size_m,
-                          const CameraIntrinsics& intrinsics) {
+                          const TagCameraIntrinsics& intrinsics) {
   if (!(tag_size_m > 0.0) || !std::isfinite(tag_size_m)) {
     throw std::invalid_argument("tag size must be a positive number of metres");
   }
@@ -74,7 +74,7 @@ TagPose estimate_tag_pose(const std::array<cv::Point2d, 4>& corners, double tag_
 }
 
 std::array<cv::Point2d, 4> project_tag_corners(const Eigen::Isometry3d& tag_in_camera, double tag_size_m,
-                                               const CameraIntrinsics& intrinsics) {
+                                               const TagCameraIntrinsics& intrinsics) {
   check_intrinsics(intrinsics);
   const std::vector<cv::Point3d> object = tag_object_points(tag_size_m);
   cv::Mat r;

@@ -13,7 +13,7 @@
 namespace bookgrasp {
 
 /// Pinhole intrinsics and distortion of the image the corners come from.
-struct CameraIntrinsics {
+struct TagCameraIntrinsics {
   double fx = 0.0;  ///< focal length x, pixels
   double fy = 0.0;  ///< focal length y, pixels
   double cx = 0.0;  ///< principal point x, pixels
@@ -40,11 +40,11 @@ struct TagPose {
 /// std::invalid_argument for a non-positive size, non-finite corners or
 /// intrinsics, and std::runtime_error if no pose is found (degenerate quad).
 TagPose estimate_tag_pose(const std::array<cv::Point2d, 4>& corners, double tag_size_m,
-                          const CameraIntrinsics& intrinsics);
+                          const TagCameraIntrinsics& intrinsics);
 
 /// Projects the four tag corners of a tag of `tag_size_m` at `tag_in_camera`
 /// into the image (same order as TagDetection::corners).
 std::array<cv::Point2d, 4> project_tag_corners(const Eigen::Isometry3d& tag_in_camera, double tag_size_m,
-                                               const CameraIntrinsics& intrinsics);
+                                               const TagCameraIntrinsics& intrinsics);
 
 }  // namespace bookgrasp

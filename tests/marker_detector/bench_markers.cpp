@@ -24,7 +24,7 @@ bookgrasp::TagDetectorParams shipped() {
 void run(benchmark::State& state, bookgrasp::TagDetectorParams p) {
   const cv::Mat img = tagtest();
   bookgrasp::TagDetector det(p);
-  bookgrasp::CameraIntrinsics k;
+  bookgrasp::TagCameraIntrinsics k;
   k.fx = k.fy = 600;
   k.cx = 319.5;
   k.cy = 239.5;

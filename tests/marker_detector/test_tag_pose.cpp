@@ -27,8 +27,8 @@ TagDetectorParams params() {
   return p;
 }
 
-CameraIntrinsics intrinsics() {
-  CameraIntrinsics k;
+TagCameraIntrinsics intrinsics() {
+  TagCameraIntrinsics k;
   k.fx = 600.0;
   k.fy = 600.0;
   k.cx = 319.5;
@@ -57,7 +57,7 @@ TEST_P(RenderedPose, RecoveredWithinMillimetresAndADegree) {
                     Eigen::AngleAxisd(c.roll * kPi / 180, Eigen::Vector3d::UnitX()))
                        .toRotationMatrix();
   Family fam;
-  const CameraIntrinsics k = intrinsics();
+  const TagCameraIntrinsics k = intrinsics();
   cv::Mat image(480, 640, CV_8UC1, cv::Scalar(140));
   test::draw_tag(image, fam.f, 7, size, truth, k.fx, k.fy, k.cx, k.cy);
 
@@ -87,7 +87,7 @@ INSTANTIATE_TEST_SUITE_P(Poses, RenderedPose,
                          });
 
 TEST(TagPose, ExactCornersGiveExactPose) {
-  const CameraIntrinsics k = intrinsics();
+  const TagCameraIntrinsics k = intrinsics();
   Eigen::Isometry3d truth = Eigen::Isometry3d::Identity();
   truth.translation() = Eigen::Vector3d(0.1, -0.02, 0.9);
   truth.linear() = Eigen::AngleAxisd(0.3, Eigen::Vector3d(1, 2, 0.5).normalized()).toRotationMatrix();
@@ -99,7 +99,7 @@ TEST(TagPose, ExactCornersGiveExactPose) {
 }
 
 TEST(TagPose, DistortionIsUsed) {
-  CameraIntrinsics k = intrinsics();
+  TagCameraIntrinsics k = intrinsics();
   k.distortion = {-0.2, 0.05, 0.001, -0.001, 0.0};
   Eigen::Isometry3d truth = Eigen::Isometry3d::Identity();
   truth.translation() = Eigen::Vector3d(-0.15, 0.1, 0.7);
@@ -109,10 +109,10 @@ TEST(TagPose, DistortionIsUsed) {
 }
 
 TEST(TagPose, BadInputsThrow) {
-  const CameraIntrinsics k = intrinsics();
+  const TagCameraIntrinsics k = intrinsics();
   const std::array<cv::Point2d, 4> corners{{{300, 260}, {340, 260}, {340, 220}, {300, 220}}};
   EXPECT_THROW(estimate_tag_pose(corners, 0.0, k), std::invalid_argument);
-  CameraIntrinsics bad = k;
+  TagCameraIntrinsics bad = k;
   bad.fx = std::nan("");
   EXPECT_THROW(estimate_tag_pose(corners, 0.1, bad), std::invalid_argument);
   auto nan_corners = corners;
