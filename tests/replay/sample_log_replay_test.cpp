@@ -82,3 +82,38 @@ TEST(ShippedConfigs, EveryRegisteredServiceBuildsFromItsDefaultConfig) {
 
 }  // namespace
 }  // namespace bookgrasp
+
+namespace bookgrasp {
+namespace {
+
+// logs/samples/arbiter_seed5.lcm: the arbiter's inputs and outputs from the composed full-cycle harness
+// on seed 5 (bookgrasp_eval_full --scenes 1 --seed 5 --log, filtered to the arbiter's channels).
+DiffReport replay_arbiter(const std::string& config_path) {
+  const auto log = read_lcm_log(std::string(BOOKGRASP_SOURCE_DIR) + "/logs/samples/arbiter_seed5.lcm");
+  std::vector<std::unique_ptr<Component>> cs;
+  cs.push_back(project_services().make("arbiter", config_path, BOOKGRASP_SOURCE_DIR));
+  const ReplayRun run = replay_log(log, std::move(cs));
+  return diff_outputs(log, run.outputs, {"GRASP_POINT"}, {}, run.fed_utimes);
+}
+
+TEST(ArbiterReplay, ShippedConfigReproducesEveryDecisionBitForBit) {
+  const DiffReport r = replay_arbiter("");
+  ASSERT_EQ(r.channels.size(), 1u);
+  EXPECT_GT(r.channels[0].matched, 10) << r.markdown();
+  EXPECT_TRUE(r.identical()) << r.markdown();
+}
+
+TEST(ArbiterReplay, TighterP1ToleranceChangesTheDecisions) {
+  std::ifstream in(std::string(BOOKGRASP_SOURCE_DIR) + "/config/services/arbiter.yaml");
+  std::stringstream ss;
+  ss << in.rdbuf();
+  const std::string changed = std::regex_replace(ss.str(), std::regex("p1_ps_y_m: 0\\.010"), "p1_ps_y_m: 0.0001");
+  ASSERT_NE(changed, ss.str());
+  const std::string path = testing::TempDir() + "/arbiter_tight.yaml";
+  std::ofstream(path) << changed;
+  const DiffReport r = replay_arbiter(path);
+  EXPECT_FALSE(r.identical()) << "a 0.1 mm P1-PS tolerance must reject the recorded P1:\n" << r.markdown();
+}
+
+}  // namespace
+}  // namespace bookgrasp
