@@ -5,6 +5,8 @@
 #include <limits>
 #include <sstream>
 #include <stdexcept>
+#include <utility>
+#include <vector>
 
 #include "common/config.h"
 
@@ -21,6 +23,9 @@ SelectionParams SelectionParams::from_config(const Config& c) {
   p.min_inside_fraction = c.get_double("min_inside_fraction", 0.0, 1.0);
   p.min_pixels = c.get_int("min_pixels", 1, 100000000);
   p.extent_quantile = c.get_double("extent_quantile", 0.0, 0.49);
+  p.split_wide_fronts = c.get<bool>("split_wide_fronts");
+  p.split_top_jump_px = c.get_int("split_top_jump_px", 1, 1000);
+  p.split_depth_step_m = c.get_double("split_depth_step_m", 0.0, 1.0);
   return p;
 }
 
@@ -74,6 +79,48 @@ std::string fmt(double v, int prec = 3) {
   s << v;
   return s.str();
 }
+/// Column bands of region `label`: split at empty columns, top-contour jumps and depth steps.
+/// `depth` is the per-pixel coordinate along the rear-board normal (NaN = none).
+std::vector<std::pair<int, int>> column_bands(const cv::Mat& labels, int label, const cv::Rect& bbox,
+                                              const cv::Mat& depth, const SelectionParams& p) {
+  std::vector<int> top(size_t(bbox.width), -1);
+  std::vector<double> med(size_t(bbox.width), std::numeric_limits<double>::quiet_NaN());
+  std::vector<double> col;
+  for (int i = 0; i < bbox.width; ++i) {
+    const int x = bbox.x + i;
+    col.clear();
+    for (int y = bbox.y; y < bbox.y + bbox.height; ++y) {
+      if (labels.at<int>(y, x) != label) continue;
+      if (top[size_t(i)] < 0) top[size_t(i)] = y;
+      const float d = depth.at<float>(y, x);
+      if (std::isfinite(d)) col.push_back(d);
+    }
+    if (!col.empty()) med[size_t(i)] = quantile(col, 0.5);
+  }
+  std::vector<std::pair<int, int>> bands;
+  int start = -1;
+  for (int i = 0; i < bbox.width; ++i) {
+    if (top[size_t(i)] < 0) {
+      if (start >= 0) bands.emplace_back(bbox.x + start, bbox.x + i - 1);
+      start = -1;
+      continue;
+    }
+    if (start >= 0) {
+      const bool jump = std::abs(top[size_t(i)] - top[size_t(i - 1)]) > p.split_top_jump_px;
+      const bool step = std::isfinite(med[size_t(i)]) && std::isfinite(med[size_t(i - 1)]) &&
+                        std::fabs(med[size_t(i)] - med[size_t(i - 1)]) > p.split_depth_step_m;
+      if (jump || step) {
+        bands.emplace_back(bbox.x + start, bbox.x + i - 1);
+        start = i;
+      }
+    } else {
+      start = i;
+    }
+  }
+  if (start >= 0) bands.emplace_back(bbox.x + start, bbox.x + bbox.width - 1);
+  return bands;
+}
+
 }  // namespace
 
 BookFrontResult select_book_front(const SegmentationResult& seg, const cv::Mat& points_camera,
@@ -104,6 +151,17 @@ BookFrontResult select_book_front(const SegmentationResult& seg, const cv::Mat& 
   BookFrontResult out;
   int best = 0;
   double best_y = std::numeric_limits<double>::infinity();
+  // Depth along the rear-board normal (box x) of every pixel, for splitting wide regions.
+  cv::Mat rear_depth(seg.labels.size(), CV_32F, cv::Scalar(std::numeric_limits<float>::quiet_NaN()));
+  if (p.split_wide_fronts) {
+    for (int y = 0; y < seg.labels.rows; ++y) {
+      const cv::Vec3f* q = points_camera.ptr<cv::Vec3f>(y);
+      float* d = rear_depth.ptr<float>(y);
+      for (int x = 0; x < seg.labels.cols; ++x)
+        if (std::isfinite(q[x][2])) d[x] = float((cam_in_box * Eigen::Vector3d(q[x][0], q[x][1], q[x][2])).x());
+    }
+  }
+  std::vector<std::pair<int, int>> band_of(K + 1, {-1, -1});
   for (const PlaneRegion& r : seg.regions) {
     RegionVerdict v;
     v.label = r.label;
@@ -145,6 +203,48 @@ BookFrontResult select_book_front(const SegmentationResult& seg, const cv::Mat& 
     } else if (v.inside_fraction < p.min_inside_fraction) {
       v.reason = "outside the upper-shelf volume: " + fmt(v.inside_fraction, 2) + " of points inside < " +
                  fmt(p.min_inside_fraction, 2);
+    } else if (v.width_m > p.max_width_m && p.split_wide_fronts) {
+      // Several coplanar fronts side by side: split into column bands, keep the right-most band that
+      // looks like one book front.
+      const std::vector<std::pair<int, int>> bands = column_bands(seg.labels, r.label, r.bbox, rear_depth, p);
+      double band_best_y = std::numeric_limits<double>::infinity();
+      int passed = 0;
+      for (const auto& [x0, x1] : bands) {
+        std::vector<double> by, bz;
+        double sum_y = 0.0;
+        for (int y = r.bbox.y; y < r.bbox.y + r.bbox.height; ++y) {
+          const int* l = seg.labels.ptr<int>(y);
+          const cv::Vec3f* q = points_camera.ptr<cv::Vec3f>(y);
+          for (int x = x0; x <= x1; ++x) {
+            if (l[x] != r.label || !std::isfinite(q[x][2])) continue;
+            const Eigen::Vector3d qc(q[x][0], q[x][1], q[x][2]);
+            const Eigen::Vector3d qb = cam_in_box * qc;
+            by.push_back(qb.y());
+            bz.push_back(qb.z());
+            sum_y += (camera_in_base * qc).y();
+          }
+        }
+        if (int(by.size()) < p.min_pixels) continue;
+        const double w = quantile(by, 1.0 - p.extent_quantile) - quantile(by, p.extent_quantile);
+        const double h = quantile(bz, 1.0 - p.extent_quantile) - quantile(bz, p.extent_quantile);
+        if (w < p.min_width_m || w > p.max_width_m || h < p.min_height_m || h > p.max_height_m) continue;
+        ++passed;
+        const double cy = sum_y / double(by.size());
+        if (cy < band_best_y) {
+          band_best_y = cy;
+          band_of[size_t(r.label)] = {x0, x1};
+        }
+      }
+      if (passed == 0) {
+        v.reason = "width " + fmt(v.width_m) + " m > " + fmt(p.max_width_m) + " and none of its " +
+                   std::to_string(bands.size()) + " column bands is a book front";
+      } else {
+        v.candidate = true;
+        if (band_best_y < best_y) {
+          best_y = band_best_y;
+          best = r.label;
+        }
+      }
     } else if (v.width_m < p.min_width_m || v.width_m > p.max_width_m) {
       v.reason = "width " + fmt(v.width_m) + " m not in [" + fmt(p.min_width_m) + ", " + fmt(p.max_width_m) + "]";
     } else if (v.height_m < p.min_height_m || v.height_m > p.max_height_m) {
@@ -167,11 +267,34 @@ BookFrontResult select_book_front(const SegmentationResult& seg, const cv::Mat& 
   }
   const PlaneRegion& r = seg.regions[size_t(best - 1)];
   out.selected_label = best;
-  out.pi = upper_right_corner(seg.labels, best, &out.pi_fallback);
+  double offset = r.offset;
+  if (band_of[size_t(best)].first >= 0) {
+    // A band of a wider region: PI of the band's pixels; the plane keeps the region's normal and takes
+    // the band's own offset (median of n . p), since neighbouring fronts can stand at other depths.
+    out.split = true;
+    out.band_x0 = band_of[size_t(best)].first;
+    out.band_x1 = band_of[size_t(best)].second;
+    cv::Mat band(seg.labels.size(), CV_32S, cv::Scalar(0));
+    std::vector<double> offs;
+    for (int y = r.bbox.y; y < r.bbox.y + r.bbox.height; ++y) {
+      const int* l = seg.labels.ptr<int>(y);
+      const cv::Vec3f* q = points_camera.ptr<cv::Vec3f>(y);
+      int* o = band.ptr<int>(y);
+      for (int x = out.band_x0; x <= out.band_x1; ++x) {
+        if (l[x] != best) continue;
+        o[x] = best;
+        if (std::isfinite(q[x][2])) offs.push_back(r.normal.dot(Eigen::Vector3d(q[x][0], q[x][1], q[x][2])));
+      }
+    }
+    if (!offs.empty()) offset = quantile(offs, 0.5);
+    out.pi = upper_right_corner(band, best, &out.pi_fallback);
+  } else {
+    out.pi = upper_right_corner(seg.labels, best, &out.pi_fallback);
+  }
   const Eigen::Vector3d ray((out.pi.x - g.cx) / g.fx, (out.pi.y - g.cy) / g.fy, 1.0);
   const double denom = r.normal.dot(ray);
   if (std::fabs(denom) > 0.05 * ray.norm()) {
-    out.p1_camera = ray * (r.offset / denom);
+    out.p1_camera = ray * (offset / denom);
   } else {
     const cv::Vec3f q = points_camera.at<cv::Vec3f>(out.pi);
     if (!std::isfinite(q[2])) {

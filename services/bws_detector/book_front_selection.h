@@ -59,6 +59,15 @@ struct SelectionParams {
   int min_pixels = 30;
   /// Extents are measured between these quantiles of the points (robust to stray pixels), e.g. 0.02.
   double extent_quantile = 0.02;
+  /// Split regions that pass the orientation and volume tests but are too wide (several coplanar
+  /// book fronts standing side by side merge into one plane) into column bands, one per book.
+  bool split_wide_fronts = true;
+  /// A new band starts where the region's top contour jumps by more than this (pixels) between
+  /// neighbouring columns (books of different heights) ...
+  int split_top_jump_px = 4;
+  /// ... or where the median depth along the rear-board normal of neighbouring columns differs by
+  /// more than this (metres; fore-edges at different depths), or at a column without region pixels.
+  double split_depth_step_m = 0.008;
 
   /// Reads every key of the `selection` section.
   static SelectionParams from_config(const Config& section);
@@ -108,6 +117,13 @@ struct BookFrontResult {
   Eigen::Vector3d p1_base = Eigen::Vector3d::Zero();
   /// One verdict per region of the segmentation, in label order.
   std::vector<RegionVerdict> regions;
+  /// True if the selected book front is a column band of a wider region (see split_wide_fronts);
+  /// columns [band_x0, band_x1] of the selected region.
+  bool split = false;
+  /// See split.
+  int band_x0 = -1;
+  /// See split.
+  int band_x1 = -1;
 };
 
 /// The paper's PI of a region: (Y_min, X_max) or the nearest region pixel (see the file comment).

@@ -5,6 +5,8 @@
 
 #include "common/config.h"
 #include "services/bws_detector/book_front_selection.h"
+#include "services/bws_detector/bws_detector_node.h"
+#include "services/bws_detector/cart_geometry.h"
 #include "services/bws_detector/disparity.h"
 #include "services/bws_detector/god_segmentation.h"
 #include "services/bws_detector/pcl_plane_segmentation.h"
@@ -12,28 +14,42 @@
 namespace bookgrasp::bws {
 namespace {
 
+using bookgrasp::BwsDetectorSettings;
+
 const std::string kDir = std::string(BOOKGRASP_SOURCE_DIR) + "/config/services/";
 
 TEST(BwsConfig, GodFileLoadsCompletely) {
   const Config c = Config::load_file(kDir + "bws_detector.yaml");
   c.mark_read("service");
-  c.mark_read("channels");
-  DisparityParams::from_config(c.child("disparity"));
-  const GodParams g = GodParams::from_config(c.child("god"));
-  EXPECT_EQ(g.merge_space, MergeSpace::kImage);
-  EXPECT_DOUBLE_EQ(g.merge_distance, 0.75);
-  SelectionParams::from_config(c.child("selection"));
+  const BwsDetectorSettings s = BwsDetectorSettings::from_config(c);
+  EXPECT_EQ(s.params.implementation, "god");
+  EXPECT_EQ(s.params.god.merge_space, MergeSpace::kImage);
+  EXPECT_DOUBLE_EQ(s.params.god.merge_distance, 0.75);
+  EXPECT_EQ(s.corner_channel, "BOOK_CORNER_STEREO");
   EXPECT_NO_THROW(c.require_all_read());
 }
 
 TEST(BwsConfig, PclFileLoadsCompletely) {
   const Config c = Config::load_file(kDir + "bws_detector_pcl.yaml");
   c.mark_read("service");
-  c.mark_read("channels");
-  DisparityParams::from_config(c.child("disparity"));
-  PclPlaneParams::from_config(c.child("pcl"));
-  SelectionParams::from_config(c.child("selection"));
+  const BwsDetectorSettings s = BwsDetectorSettings::from_config(c);
+  EXPECT_EQ(s.params.implementation, "pcl");
+  EXPECT_EQ(s.corner_channel, "BOOK_CORNER_STEREO");
   EXPECT_NO_THROW(c.require_all_read());
+}
+
+TEST(BwsConfig, BadCartGeometryNamesTheKey) {
+  std::string yaml = "cart: {marker_role: cart, marker_in_cart_m: [0.359, 0.3, 0.37], upper_shelf_min_m: [0, -0.4, 0], "
+                     "upper_shelf_max_m: [0.34, 0.4, 0.33], max_marker_age_s: 1.0}";
+  EXPECT_NO_THROW(CartGeometry::from_config(Config::from_string(yaml, "t.yaml").child("cart")));
+  std::string bad = yaml;
+  bad.replace(bad.find("[0.34, 0.4, 0.33]"), 17, "[0.34, -0.5, 0.33]");
+  try {
+    CartGeometry::from_config(Config::from_string(bad, "t.yaml").child("cart"));
+    ADD_FAILURE() << "no error for max < min";
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("upper_shelf_max_m"), std::string::npos) << e.what();
+  }
 }
 
 TEST(BwsConfig, BadValuesNameTheKey) {

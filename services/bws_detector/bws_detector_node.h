@@ -1,0 +1,73 @@
+#pragma once
+/// @file
+/// The bws_detector component: STEREO_IMAGES + MARKERS -> BOOK_CORNER_STEREO
+/// (P1 of the right-most book of the upper shelf, in base and grasp, with every
+/// region's verdict) and an optional debug picture. Both implementations (GoD,
+/// PCL) are this component with another `service.implementation`; they publish
+/// the same message on the same channel with their name in `implementation`.
+
+#include <cstdint>
+#include <optional>
+#include <string>
+
+#include <Eigen/Geometry>
+
+#include "bookgrasp/book_corner_stereo_t.hpp"
+#include "bookgrasp/marker_detections_t.hpp"
+#include "bookgrasp/stereo_frame_t.hpp"
+#include "common/component.h"
+#include "common/config.h"
+#include "services/bws_detector/bws_pipeline.h"
+
+namespace bookgrasp {
+
+/// Everything the bws_detector reads from its configuration.
+struct BwsDetectorSettings {
+  std::string stereo_channel;       ///< channels.stereo (stereo_frame_t)
+  std::string markers_channel;      ///< channels.markers (marker_detections_t)
+  std::string corner_channel;       ///< channels.corner (book_corner_stereo_t)
+  std::string debug_image_channel;  ///< channels.debug_image (image_t, PNG)
+  bool publish_debug_image = false; ///< debug.publish_image
+  std::string cart_marker_role;     ///< cart.marker_role: role of the cart marker in MARKERS
+  bool measure_processing_time = true;  ///< diagnostics.measure_processing_time (wall-time *_ms fields)
+  bws::BwsParams params;            ///< algorithm (service.implementation, disparity, god|pcl, selection, cart)
+
+  /// Reads the whole configuration root. Throws ConfigError naming a bad key.
+  static BwsDetectorSettings from_config(const Config& root);
+};
+
+/// Decodes and checks a stereo frame: both images decodable, 8-bit, same size,
+/// the left calibration for that size with finite positive intrinsics, a
+/// finite positive baseline, a valid camera pose. Returns "" and fills `input`,
+/// or the reason.
+std::string stereo_input_from_frame(const stereo_frame_t& frame, bws::StereoInput* input);
+
+/// The BwS detector as a component.
+class BwsDetectorNode : public Component {
+ public:
+  /// Subscribes the stereo and marker channels.
+  explicit BwsDetectorNode(const BwsDetectorSettings& settings);
+
+  /// The handler's core, usable without a bus: answers one frame with the
+  /// latest cart marker. Returns "" and fills `out` (and `debug` if not null
+  /// and the debug image is enabled), or the reason the frame is rejected.
+  std::string process(const stereo_frame_t& frame, book_corner_stereo_t* out, image_t* debug);
+
+  /// Takes the cart marker from a MARKERS message; returns "" or why it was refused.
+  std::string take_markers(const marker_detections_t& msg);
+
+  /// The full result of the last frame process() answered (images, regions, verdicts), for
+  /// evaluation and debugging; empty before the first.
+  const bws::BwsOutput& last_output() const { return last_; }
+
+ private:
+  void on_stereo(const stereo_frame_t& frame);
+  void on_markers(const marker_detections_t& msg);
+
+  BwsDetectorSettings s_;
+  std::optional<Eigen::Isometry3d> marker_in_base_;
+  int64_t marker_utime_ = 0;
+  bws::BwsOutput last_;
+};
+
+}  // namespace bookgrasp
