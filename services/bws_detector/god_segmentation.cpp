@@ -159,7 +159,7 @@ cv::Mat vote_clusters(const cv::Mat& bins, int num_bins, int n) {
   };
   for (int y = 0; y <= std::min(r, H - 1); ++y) col_update(y, +1);
   cv::Mat out(bins.size(), CV_8U, cv::Scalar(255));
-  std::vector<int32_t> hist(size_t(K), 0);
+  std::vector<uint16_t> hist(size_t(K), 0);  // n * n <= 101 * 101 votes fit in 16 bits
   for (int y = 0; y < H; ++y) {
     if (y > 0) {
       if (y + r < H) col_update(y + r, +1);
@@ -168,14 +168,14 @@ cv::Mat vote_clusters(const cv::Mat& bins, int num_bins, int n) {
     std::fill(hist.begin(), hist.end(), 0);
     for (int x = 0; x <= std::min(r, W - 1); ++x) {
       const uint16_t* c = &col[size_t(x) * size_t(K)];
-      for (int k = 0; k < K; ++k) hist[size_t(k)] += c[k];
+      for (int k = 0; k < K; ++k) hist[size_t(k)] = uint16_t(hist[size_t(k)] + c[k]);
     }
     const uint8_t* b = bins.ptr<uint8_t>(y);
     uint8_t* o = out.ptr<uint8_t>(y);
     for (int x = 0; x < W; ++x) {
       if (b[x] < num_bins) {
         int best = 0;
-        int32_t best_votes = hist[0];
+        uint16_t best_votes = hist[0];
         for (int k = 1; k < num_bins; ++k)
           if (hist[size_t(k)] > best_votes) {
             best_votes = hist[size_t(k)];
@@ -185,11 +185,11 @@ cv::Mat vote_clusters(const cv::Mat& bins, int num_bins, int n) {
       }
       if (x + r + 1 < W) {
         const uint16_t* c = &col[size_t(x + r + 1) * size_t(K)];
-        for (int k = 0; k < K; ++k) hist[size_t(k)] += c[k];
+        for (int k = 0; k < K; ++k) hist[size_t(k)] = uint16_t(hist[size_t(k)] + c[k]);
       }
       if (x - r >= 0) {
         const uint16_t* c = &col[size_t(x - r) * size_t(K)];
-        for (int k = 0; k < K; ++k) hist[size_t(k)] -= c[k];
+        for (int k = 0; k < K; ++k) hist[size_t(k)] = uint16_t(hist[size_t(k)] - c[k]);
       }
     }
   }
@@ -284,23 +284,43 @@ SegmentationResult segment_god(const cv::Mat& image, const cv::Mat& points, cons
   }
   if (same) omom = mom;
 
-  // Adjacency within the Chebyshev radius (forward half of the window).
+  // Adjacency within the Chebyshev radius (forward half of the window). When a pixel has the label of
+  // its left neighbour, the pairs of its forward half-window are those of the left neighbour's plus
+  // the entering column x + R (rows y..y+R): only that column is scanned. Consecutive duplicates are
+  // not pushed.
   const int R = params.adjacency_radius_px;
   std::vector<uint64_t> edges;
+  edges.reserve(size_t(count) * 16);
+  uint64_t last_edge = 0;
+  const auto push = [&](int a, int b) {
+    const uint64_t lo = uint64_t(std::min(a, b)), hi = uint64_t(std::max(a, b));
+    const uint64_t e = (lo << 32) | hi;
+    if (e != last_edge) {
+      edges.push_back(e);
+      last_edge = e;
+    }
+  };
   for (int y = 0; y < H; ++y) {
     const int* l = dbg.initial_labels.ptr<int>(y);
     for (int x = 0; x < W; ++x) {
       const int a = l[x];
       if (a == 0) continue;
+      if (x > 0 && l[x - 1] == a) {
+        const int xx = x + R;
+        if (xx >= W) continue;
+        for (int dy = 0; dy <= R && y + dy < H; ++dy) {
+          const int b = dbg.initial_labels.ptr<int>(y + dy)[xx];
+          if (b != 0 && b != a) push(a, b);
+        }
+        continue;
+      }
       for (int dy = 0; dy <= R && y + dy < H; ++dy) {
         const int* ln = dbg.initial_labels.ptr<int>(y + dy);
         for (int dx = (dy == 0 ? 1 : -R); dx <= R; ++dx) {
           const int xx = x + dx;
           if (xx < 0 || xx >= W) continue;
           const int b = ln[xx];
-          if (b == 0 || b == a) continue;
-          const uint64_t lo = uint64_t(std::min(a, b)), hi = uint64_t(std::max(a, b));
-          edges.push_back((lo << 32) | hi);
+          if (b != 0 && b != a) push(a, b);
         }
       }
     }
@@ -313,9 +333,24 @@ SegmentationResult segment_god(const cv::Mat& image, const cv::Mat& points, cons
   UnionFind uf(size_t(count) + 1);
   std::vector<Plane> planes(size_t(count) + 1);
   std::vector<Plane> oplanes(size_t(count) + 1);
+  std::vector<uint8_t> fitted(size_t(count) + 1, 0);  // bit 0: planes[i] current, bit 1: oplanes[i] current
+  const auto plane = [&](int i) -> const Plane& {
+    if (!(fitted[size_t(i)] & 1)) {
+      planes[size_t(i)] = fit_plane(mom[size_t(i)]);
+      fitted[size_t(i)] |= 1;
+    }
+    return planes[size_t(i)];
+  };
+  const auto oplane = [&](int i) -> const Plane& {
+    if (!(fitted[size_t(i)] & 2)) {
+      oplanes[size_t(i)] = fit_plane(omom[size_t(i)]);
+      fitted[size_t(i)] |= 2;
+    }
+    return oplanes[size_t(i)];
+  };
   for (int i = 1; i <= count; ++i) {
-    planes[size_t(i)] = fit_plane(mom[size_t(i)]);
-    oplanes[size_t(i)] = fit_plane(omom[size_t(i)]);
+    // Fitted lazily (most initial segments are never the larger region of a pair or gated).
+    fitted[size_t(i)] = 0;
   }
   const double cos_gate = std::cos(params.merge_max_angle_deg * M_PI / 180.0);
   const double gate_n = double(params.merge_angle_min_px);
@@ -342,11 +377,11 @@ SegmentationResult segment_god(const cv::Mat& image, const cv::Mat& points, cons
     auto merge_cost = [&](int a, int b) {
       const bool a_large = mom[size_t(a)].n >= mom[size_t(b)].n;
       const int L = a_large ? a : b, S = a_large ? b : a;
-      if (!planes[size_t(L)].valid || mom[size_t(S)].n <= 0.0) return -1.0;
-      const double d = rms_distance(mom[size_t(S)], planes[size_t(L)]);
+      if (!plane(L).valid || mom[size_t(S)].n <= 0.0) return -1.0;
+      const double d = rms_distance(mom[size_t(S)], plane(L));
       if (!(d < T)) return -1.0;
-      if (omom[size_t(a)].n >= gate_n && omom[size_t(b)].n >= gate_n && oplanes[size_t(a)].valid &&
-          oplanes[size_t(b)].valid && std::fabs(oplanes[size_t(a)].normal.dot(oplanes[size_t(b)].normal)) < cos_gate)
+      if (omom[size_t(a)].n >= gate_n && omom[size_t(b)].n >= gate_n && oplane(a).valid && oplane(b).valid &&
+          std::fabs(oplane(a).normal.dot(oplane(b).normal)) < cos_gate)
         return -1.0;
       return d;
     };
@@ -369,8 +404,7 @@ SegmentationResult segment_god(const cv::Mat& image, const cv::Mat& points, cons
       const int other = root == a ? b : a;
       mom[size_t(root)].add(mom[size_t(other)]);
       omom[size_t(root)].add(omom[size_t(other)]);
-      planes[size_t(root)] = fit_plane(mom[size_t(root)]);
-      oplanes[size_t(root)] = fit_plane(omom[size_t(root)]);
+      fitted[size_t(root)] = 0;
       touched[size_t(root)] = 1;
       ++dbg.merges;
       ++merged_this_round;
@@ -410,8 +444,8 @@ SegmentationResult segment_god(const cv::Mat& image, const cv::Mat& points, cons
             const int xx = x + dx;
             if (xx < 0 || xx >= W) continue;
             const int b = ln[xx];
-            if (b == 0 || b == best || !planes[size_t(b)].valid) continue;
-            const double d = std::fabs(planes[size_t(b)].normal.dot(v) - planes[size_t(b)].offset);
+            if (b == 0 || b == best || !plane(b).valid) continue;
+            const double d = std::fabs(plane(b).normal.dot(v) - plane(b).offset);
             if (d < best_d || (d == best_d && best != 0 && b < best)) {
               best_d = d;
               best = b;
