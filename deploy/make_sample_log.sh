@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Records a small sample log of the running system for the replay tests: every process of
-# deploy/processes.txt, cameras publishing JPEG (so the log stays small), for N seconds of
-# wall time after all services report alive.
+# deploy/processes.txt, cameras publishing JPEG (so the log stays small), from the system's start
+# until N seconds of wall time after all services report alive.
 #   deploy/make_sample_log.sh OUT.lcm [SECONDS]
 set -euo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
@@ -13,16 +13,25 @@ export BOOKGRASP_PROCESSES="$TMP/processes.txt"
 cleanup() { "$ROOT/deploy/bookgrasp" stop >/dev/null 2>&1 || true; rm -rf "$TMP"; }
 trap cleanup EXIT
 # The same processes; camera configurations switched to JPEG in temporary copies.
-while read -r name binary config; do
+while read -r name binary config extra; do
   case "$name" in \#*|"") continue ;; esac
   if [[ "$name" == *camera ]]; then
     sed 's/^image_encoding: raw/image_encoding: jpeg/' "$ROOT/$config" > "$TMP/$name.yaml"
     config="$TMP/$name.yaml"
   fi
-  echo "$name $binary ${config#$ROOT/}"
+  echo "$name $binary ${config#$ROOT/} $extra"
 done < "$ROOT/deploy/processes.txt" > "$BOOKGRASP_PROCESSES"
-names=$(awk '{print $1}' "$BOOKGRASP_PROCESSES" | paste -sd, -)
+names=$(grep -vw standby "$BOOKGRASP_PROCESSES" | awk '{print $1}' | paste -sd, -)
+# The logger starts first, so the recording holds every input from the system's start: a replay then
+# sees exactly what the live processes saw (no state from before the log).
+rm -f "$OUT"
+lcm-logger --lcm-url="$BOOKGRASP_LCM_URL" --quiet --force "$OUT" &
+logger=$!
 "$ROOT/deploy/bookgrasp" start
 "$ROOT/build/services/monitor/bookgrasp_monitor" --lcm-url "$BOOKGRASP_LCM_URL" --expect "$names" --timeout 60 >/dev/null
-timeout --signal=INT "$SECONDS_TO_RECORD" lcm-logger --lcm-url="$BOOKGRASP_LCM_URL" --quiet "$OUT" || true
+sleep "$SECONDS_TO_RECORD"
+"$ROOT/deploy/bookgrasp" stop >/dev/null
+kill -INT "$logger"
+wait "$logger" || true
+[ -s "$OUT" ] || { echo "error: lcm-logger wrote nothing to $OUT" >&2; exit 1; }
 echo "wrote $OUT ($(du -h "$OUT" | cut -f1))"

@@ -26,6 +26,9 @@
 #ifdef BOOKGRASP_HAVE_ARM_DRIVER
 #include "services/arm_driver/arm_driver_service.h"
 #endif
+#ifdef BOOKGRASP_HAVE_BWS_DETECTOR
+#include "services/bws_detector/bws_detector_service.h"
+#endif
 
 namespace bookgrasp {
 
@@ -54,6 +57,9 @@ ComponentRegistry project_services() {
 #endif
 #ifdef BOOKGRASP_HAVE_ARM_DRIVER
   r.add(arm_driver_service());
+#endif
+#ifdef BOOKGRASP_HAVE_BWS_DETECTOR
+  r.add(bws_detector_service());
 #endif
   return r;
 }
