@@ -87,20 +87,20 @@ void ServoSession::advance(int64_t utime, SessionOutput* out) {
     return;
   }
   const double since_good = (now_ - last_good_utime_) * 1e-6;
-  if (since_good > p_.feature_lost_timeout_s) {
+  if (now_ - last_good_utime_ > seconds_to_us(p_.feature_lost_timeout_s)) {
     std::string why = last_lost_reason_.empty() ? "no feature measurement arrived" : last_lost_reason_;
     finish(ServoState::kFeatureLost,
            fmt("feature lost for %.2f s (feature_lost_timeout_s %.2f): ", since_good, p_.feature_lost_timeout_s) + why,
            out);
     return;
   }
-  const bool stale = since_good > p_.stale_feature_s;
+  const bool stale = now_ - last_good_utime_ > seconds_to_us(p_.stale_feature_s);
   if (stale && !holding_) {
     holding_ = true;
     command(GripperTwist::Zero(), out);
     return;
   }
-  if (last_command_utime_ == INT64_MIN || (now_ - last_command_utime_) * 1e-6 >= p_.command_period_s) command(stale ? GripperTwist::Zero() : twist_, out);
+  if (last_command_utime_ == INT64_MIN || now_ - last_command_utime_ >= seconds_to_us(p_.command_period_s)) command(stale ? GripperTwist::Zero() : twist_, out);
 }
 
 SessionOutput ServoSession::on_request(const ServoRequest& request) {

@@ -27,13 +27,14 @@ StripeServoStep StripeEndServo::step(const StripeObservation& obs, double stando
         obs.found && ut >= std::min(obs.line_start_px.x(), obs.line_end_px.x()) - 1.0 &&
         ut <= std::max(obs.line_start_px.x(), obs.line_end_px.x()) + 1.0;
     if (!covers_target) occlusion_seen_ = true;
+    // An end is the left end of the right-most visible segment (BSwH, end_side left). Before
+    // the books have hidden the stripe (require_occlusion), ends are ignored: they may be a
+    // side panel or the end of the segment left of the book row.
+    const bool armed = occlusion_seen_ || !p_.require_occlusion;
     bool accept = false;
-    if (obs.end_found) {
-      if (p_.search_direction > 0) {
-        accept = (occlusion_seen_ || !p_.require_occlusion) && obs.end_px.x() >= ut - 1.0;
-      } else {
-        accept = (occlusion_seen_ || !p_.require_occlusion) && obs.end_px.x() <= ut + 1.0;
-      }
+    if (obs.end_found && armed) {
+      // Searching towards +y (right) from the left of the books, the wanted end comes in from the right.
+      accept = !p_.require_occlusion || p_.search_direction < 0 || obs.end_px.x() >= ut - 1.0;
     }
     if (accept) {
       phase_ = StripePhase::kTrack;
@@ -48,7 +49,11 @@ StripeServoStep StripeEndServo::step(const StripeObservation& obs, double stando
         return out;
       }
       GripperTwist t = GripperTwist::Zero();
-      t(1) = p_.search_speed * p_.search_direction;
+      // The stripe seen without its end (it runs out of the image on the end side): the end is that
+      // way (unless the search starts left of the books: require_occlusion). Otherwise keep the
+      // configured search direction.
+      const bool end_beyond_border = obs.found && !obs.end_found && !p_.require_occlusion;
+      t(1) = p_.search_speed * (end_beyond_border ? p_.end_side_direction : p_.search_direction);
       if (obs.found) {
         // Keep the stripe's centre line at the target row (height of the TCP = stripe height).
         const Eigen::Vector2d a = obs.line_start_px, b = obs.line_end_px;

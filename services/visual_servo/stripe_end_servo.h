@@ -8,14 +8,18 @@
 /// depth is the predefined standoff).
 ///
 /// Two phases:
-///  - SEARCH: constant speed along the gripper y axis (search_direction), the
-///    height corrected on the stripe's centre line when it is seen. With
+///  - SEARCH: constant speed along the gripper y axis, the height corrected on
+///    the stripe's centre line when it is seen. Direction: towards the end side
+///    (end_side_direction) when the stripe is seen running out of the image on
+///    that side, else search_direction (the stripe hidden behind books). With
 ///    require_occlusion the robot starts on the far side of the books (the
 ///    cart marker is on the left of the default cart) and first has to pass
 ///    behind books: an end is accepted only after the stripe was hidden at the
 ///    target column at least once, and only when it lies at or beyond the
 ///    target column in the search direction (so the end of the stripe segment
-///    left of the book row, or a side panel, is never taken).
+///    left of the book row, or a side panel, is never taken). Without it (the
+///    coordinator's station A on the right part of the stripe, where only the
+///    segment right of the books can be seen) the first end seen is tracked.
 ///  - TRACK: the end is back-projected onto the board plane (z_gripper =
 ///    standoff) and the TCP moves towards it with a proportional law,
 ///    saturated. Converged when the metric error is within tolerance for
@@ -35,7 +39,9 @@ struct StripeEndServoParams {
   double gain = 1.0;                  ///< 1/s on the metric position error (TRACK)
   double max_linear_speed = 0.05;     ///< m/s while tracking
   double search_speed = 0.1;          ///< m/s along the stripe while searching
-  int search_direction = +1;          ///< +1 = gripper +y (right as seen from the robot), -1 = left
+  int search_direction = +1;          ///< while the stripe is hidden: +1 = gripper +y (right as seen from the robot), -1 = left
+  int end_side_direction = -1;        ///< where the end lies from a visible segment whose end is outside the image
+                                      ///< (BSwH end_side: left = -1, right = +1)
   bool require_occlusion = true;      ///< accept an end only after the stripe was hidden at the target column
   double converged_x_m = 0.0015;      ///< |error up| below this ...
   double converged_y_m = 0.0015;      ///< ... and |error right| below this ...

@@ -67,6 +67,7 @@ VisualServoSettings VisualServoSettings::from_config(const Config& root) {
   s.stripe.max_linear_speed = st.get_double("max_linear_speed", 0.0, 1);
   s.stripe.search_speed = st.get_double("search_speed", 0.001, 1);
   s.stripe.search_direction = direction(st, "search_direction");
+  s.stripe.end_side_direction = direction(st, "end_side");
   s.stripe.require_occlusion = st.get<bool>("require_occlusion");
   s.stripe.converged_x_m = st.get_double("converged_x_m", 1e-5, 0.1);
   s.stripe.converged_y_m = st.get_double("converged_y_m", 1e-5, 0.1);

@@ -84,6 +84,23 @@ TEST(StripeEndServo, StartingRightOfTheEndSearchingLeft) {
   EXPECT_NEAR(r.tcp.translation().y(), scene.books_right, 1.5e-3);
 }
 
+TEST(StripeEndServo, StartingOverTheBooksOrRightOfThemWithoutOcclusionRule) {
+  // The coordinator's station A: on the right part of the stripe, maybe in front of the books.
+  for (double a_y : {0.0, 0.12, 0.3}) {
+    test::StripeScene scene;
+    scene.books_left = -0.35;
+    scene.books_right = 0.15;
+    StripeEndServoParams p = params();
+    p.require_occlusion = false;
+    Eigen::Isometry3d a = Eigen::Isometry3d::Identity();
+    a.translation() = Eigen::Vector3d(-0.01, a_y, 0.0);
+    const RunResult r = run(scene, a, scene.board_z, p);
+    ASSERT_TRUE(r.converged) << a_y;
+    EXPECT_NEAR(r.tcp.translation().y(), scene.books_right, 1.5e-3) << a_y;
+    EXPECT_NEAR(r.tcp.translation().x(), scene.stripe_x, 1.5e-3) << a_y;
+  }
+}
+
 TEST(StripeEndServo, GivesUpAfterTheMaximumSearchDistance) {
   test::StripeScene scene;
   scene.books_left = -0.4;

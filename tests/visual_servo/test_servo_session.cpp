@@ -1,0 +1,198 @@
+// ServoSession timing and outcomes in message time: feature lost, hold, heartbeat,
+// timeout, start checks, cancel, stale/mismatched measurements, converged pose at capture.
+#include <gtest/gtest.h>
+
+#include "servo_plant.h"
+#include "services/visual_servo/servo_session.h"
+
+namespace bookgrasp {
+namespace {
+
+constexpr int64_t kT0 = 1'000'000'000;
+
+ServoSessionParams session_params() {
+  ServoSessionParams p;
+  p.feature_lost_timeout_s = 0.6;
+  p.stale_feature_s = 0.25;
+  p.command_period_s = 0.05;
+  p.default_timeout_s = 20;
+  p.max_start_error_m = 0.03;
+  p.default_corner_standoff_m = 0.2;
+  p.default_stripe_standoff_m = 0.5;
+  p.pose_history_s = 1.0;
+  return p;
+}
+
+struct Fixture : ::testing::Test {
+  HandEyeGeometry geo = test::project_geometry();
+  ServoSession session{geo, session_params(), BookCornerServoParams{}, StripeEndServoParams{}};
+  std::vector<ServoCommand> commands;
+  std::vector<ServoReport> reports;
+
+  void take(const SessionOutput& o) {
+    commands.insert(commands.end(), o.commands.begin(), o.commands.end());
+    reports.insert(reports.end(), o.reports.begin(), o.reports.end());
+  }
+  static Eigen::Isometry3d pose_x(double x) {
+    Eigen::Isometry3d p = Eigen::Isometry3d::Identity();
+    p.translation().x() = x;
+    return p;
+  }
+  void arm(int64_t t, double x = 0, ArmCondition c = ArmCondition::kExecuting, const std::string& m = "") {
+    take(session.on_arm_state(t, pose_x(x), c, m));
+  }
+  void start_corner(int64_t t, double timeout_s = 0) {
+    ServoRequest r;
+    r.utime = t;
+    r.request_id = 7;
+    r.mode = ServoMode::kBookCorner;
+    r.timeout_s = timeout_s;
+    take(session.on_request(r));
+  }
+  BookObservation book(int64_t t, bool found, Eigen::Vector2d px = {400, 300}) {
+    BookObservation o;
+    o.utime = t;
+    o.found = found;
+    o.failure_reason = found ? "" : "no region passes the book criteria";
+    o.r_px = px;
+    return o;
+  }
+  const ServoReport& last_report() const { return reports.back(); }
+};
+
+TEST_F(Fixture, FeatureLostStopsTheArmAndSaysWhy) {
+  arm(kT0);
+  start_corner(kT0);
+  ASSERT_EQ(last_report().state, ServoState::kRunning);
+  int64_t t = kT0;
+  int64_t last_good = 0;
+  for (int i = 1; i <= 200; ++i) {  // arm states at 100 Hz, images at 10 Hz, lost after 0.3 s
+    t = kT0 + i * 10'000;
+    arm(t);
+    if (i % 10 == 0) {
+      const bool found = t <= kT0 + 300'000;
+      if (found) last_good = t;
+      take(session.on_book(book(t, found)));
+    }
+    if (!session.running()) break;
+  }
+  ASSERT_FALSE(session.running());
+  EXPECT_EQ(last_report().state, ServoState::kFeatureLost);
+  EXPECT_NE(last_report().message.find("no region passes the book criteria"), std::string::npos) << last_report().message;
+  EXPECT_TRUE(commands.back().stop);
+  // Stopped just after feature_lost_timeout_s of message time.
+  EXPECT_GT(t - last_good, 600'000);
+  EXPECT_LE(t - last_good, 610'000);
+  // While stale (> 0.25 s) the commands were zero velocity.
+  bool zero_seen = false;
+  for (const auto& c : commands)
+    if (!c.stop && c.utime > last_good + 250'000) {
+      EXPECT_EQ(c.twist.norm(), 0.0);
+      zero_seen = true;
+    }
+  EXPECT_TRUE(zero_seen);
+}
+
+TEST_F(Fixture, CommandsRepeatAtLeastEveryCommandPeriod) {
+  arm(kT0);
+  start_corner(kT0);
+  for (int i = 1; i <= 100; ++i) {
+    const int64_t t = kT0 + i * 10'000;
+    arm(t);
+    if (i % 10 == 0) take(session.on_book(book(t, true)));
+  }
+  ASSERT_TRUE(session.running());
+  ASSERT_GT(commands.size(), 15u);
+  for (size_t i = 1; i < commands.size(); ++i) EXPECT_LE(commands[i].utime - commands[i - 1].utime, 50'000);
+  EXPECT_GT(commands.back().twist.norm(), 0.0);  // R is off target: moving
+}
+
+TEST_F(Fixture, TimeoutInMessageTime) {
+  arm(kT0);
+  start_corner(kT0, 1.0);
+  int64_t t = kT0;
+  for (int i = 1; i <= 300 && session.running(); ++i) {
+    t = kT0 + i * 10'000;
+    arm(t);
+    if (i % 5 == 0) take(session.on_book(book(t, true)));
+  }
+  EXPECT_EQ(last_report().state, ServoState::kTimeout);
+  EXPECT_EQ(t, kT0 + 1'000'000);
+  EXPECT_TRUE(commands.back().stop);
+}
+
+TEST_F(Fixture, StartChecks) {
+  ServoRequest r;
+  r.request_id = 1;
+  r.mode = ServoMode::kStripeEnd;
+  take(session.on_request(r));
+  EXPECT_EQ(last_report().state, ServoState::kFailed);
+  EXPECT_NE(last_report().message.find("ARM_STATE"), std::string::npos);
+
+  arm(kT0, 0.0);
+  r.start_pose = pose_x(0.1);
+  take(session.on_request(r));
+  EXPECT_EQ(last_report().state, ServoState::kFailed);
+  EXPECT_NE(last_report().message.find("start_pose"), std::string::npos);
+  EXPECT_FALSE(session.running());
+
+  r.start_pose = pose_x(0.02);
+  take(session.on_request(r));
+  EXPECT_EQ(last_report().state, ServoState::kRunning);
+}
+
+TEST_F(Fixture, CancelAndReplace) {
+  arm(kT0);
+  start_corner(kT0);
+  start_corner(kT0 + 10);  // replaces: the first is reported cancelled
+  ASSERT_GE(reports.size(), 3u);
+  EXPECT_EQ(reports[reports.size() - 2].state, ServoState::kCancelled);
+  ServoRequest c;
+  c.mode = ServoMode::kCancel;
+  c.request_id = 9;
+  take(session.on_request(c));
+  EXPECT_EQ(last_report().state, ServoState::kCancelled);
+  EXPECT_TRUE(commands.back().stop);
+  EXPECT_FALSE(session.running());
+}
+
+TEST_F(Fixture, IgnoresImagesBeforeTheStartAndOtherRanks) {
+  arm(kT0 + 100'000);
+  start_corner(kT0 + 100'000);
+  take(session.on_book(book(kT0 + 50'000, true)));  // taken before the request
+  BookObservation other = book(kT0 + 110'000, true);
+  other.rank_from_right = 1;  // answers another rank
+  take(session.on_book(other));
+  EXPECT_EQ(last_report().iterations, 0);
+  take(session.on_book(book(kT0 + 120'000, true)));
+  EXPECT_EQ(last_report().iterations, 1);
+}
+
+TEST_F(Fixture, ConvergedPoseIsThePoseAtCapture) {
+  arm(kT0, 0.0);
+  start_corner(kT0);
+  const Eigen::Vector2d target = geo.target_pixel(0.2);
+  for (int i = 1; i <= 30 && session.running(); ++i) {
+    const int64_t t = kT0 + i * 10'000;
+    arm(t, 0.001 * i);  // the arm reports a moving TCP
+    if (i % 10 == 0) take(session.on_book(book(t - 5'000, true, target)));  // image 5 ms old
+  }
+  ASSERT_EQ(last_report().state, ServoState::kConverged);
+  ASSERT_TRUE(last_report().converged_pose.has_value());
+  // Captured at kT0 + 295 ms: the last arm state at or before that is i = 29.
+  EXPECT_NEAR(last_report().converged_pose->translation().x(), 0.029, 1e-12);
+  EXPECT_TRUE(commands.back().stop);
+}
+
+TEST_F(Fixture, ArmDriverStopFailsTheTask) {
+  arm(kT0, 0, ArmCondition::kIdle);
+  start_corner(kT0);
+  take(session.on_book(book(kT0 + 10'000, true)));
+  arm(kT0 + 20'000, 0, ArmCondition::kExecuting);
+  arm(kT0 + 30'000, 0, ArmCondition::kStopped, "workspace limit: TCP z 1.31 > 1.30");
+  EXPECT_EQ(last_report().state, ServoState::kFailed);
+  EXPECT_NE(last_report().message.find("workspace limit"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace bookgrasp
