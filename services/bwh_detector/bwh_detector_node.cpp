@@ -12,7 +12,9 @@ BwhDetectorSettings BwhDetectorSettings::from_config(const Config& root) {
   s.input_channel = root.get<std::string>("channels.input");
   s.output_channel = root.get<std::string>("channels.output");
   s.servo_request_channel = root.get<std::string>("channels.servo_request");
+  s.method = root.get_choice("method", {"page_faces", "canny_regions"});
   s.books = BookDetectionParams::from_config(root.child("books"));
+  s.page_faces = PageFaceParams::from_config(root.child("page_faces"));
   s.measure_processing_time = root.get<bool>("diagnostics.measure_processing_time");
   return s;
 }
@@ -53,7 +55,12 @@ bool BwhDetectorNode::process(const hand_image_t& msg, book_features_hand_t* out
   const auto start = std::chrono::steady_clock::now();
   cv::Mat image;
   if (!decode_hand_image(msg, &image, reason)) return false;
-  const BookDetection d = detect_books_hand(image, settings_.books);
+  if (settings_.method == "page_faces" && image.type() != CV_8UC3) {
+    *reason = "method page_faces needs a colour image (RGB8, PNG or JPEG colour); got grey";
+    return false;
+  }
+  const BookDetection d = settings_.method == "page_faces" ? detect_books_page_faces(image, settings_.page_faces)
+                                                           : detect_books_hand(image, settings_.books);
   out->utime = msg.image.utime;
   out->implementation = implementation();
   out->rank_from_right = rank_;

@@ -12,6 +12,7 @@
 #include "common/component.h"
 #include "common/config.h"
 #include "services/bwh_detector/book_detection_hand.h"
+#include "services/bwh_detector/page_face_detection.h"
 
 namespace bookgrasp {
 
@@ -20,7 +21,9 @@ struct BwhDetectorSettings {
   std::string input_channel;          ///< channels.input (hand_image_t)
   std::string output_channel;         ///< channels.output (book_features_hand_t)
   std::string servo_request_channel;  ///< channels.servo_request (servo_request_t)
-  BookDetectionParams books;          ///< books.*
+  std::string method;                 ///< method: "page_faces" (rendered/real views, default) or "canny_regions"
+  BookDetectionParams books;          ///< books.* (canny_regions)
+  PageFaceParams page_faces;          ///< page_faces.* (page_faces)
   bool measure_processing_time = true;  ///< diagnostics.measure_processing_time
 
   /// Reads the configuration root. Throws ConfigError naming a bad key.

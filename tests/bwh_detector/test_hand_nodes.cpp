@@ -44,9 +44,15 @@ hand_image_t hand_image(const cv::Mat& rgb, int64_t utime) {
 
 class HandNodes : public ::testing::Test {
  protected:
+  static BwhDetectorSettings synthetic_settings() {
+    // The synthetic images are frontal views: the region detector (canny_regions) is tested here;
+    // page_faces is tested on rendered views (tests/visual_servo/test_servo_closed_loop).
+    BwhDetectorSettings s = BwhDetectorSettings::from_config(Config::load_file(kConfigDir + "bwh_detector.yaml"));
+    s.method = "canny_regions";
+    return s;
+  }
   HandNodes() {
-    bwh = &comp.add(std::make_unique<BwhDetectorNode>(
-        BwhDetectorSettings::from_config(Config::load_file(kConfigDir + "bwh_detector.yaml"))));
+    bwh = &comp.add(std::make_unique<BwhDetectorNode>(synthetic_settings()));
     bswh = &comp.add(std::make_unique<BswhDetectorNode>(
         BswhDetectorSettings::from_config(Config::load_file(kConfigDir + "bswh_detector.yaml"))));
     comp.bus().subscribe("BOOK_FEATURES_HAND", &Collector::on_books, &col);
