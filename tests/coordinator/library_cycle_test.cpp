@@ -92,14 +92,14 @@ TEST(LibraryCycle, ThreeBooksWholeCycleEveryTransitionAndPlacements) {
   EXPECT_EQ(cycle.status().books_moved, 3);
 
   // Lower shelf: right covers at 0.37, 0.37 - 0.025 - 0.005 = 0.34, 0.34 - 0.020 - 0.005 = 0.315;
-  // TCP Y = right - BW/2; X = -0.35 + height + 0.005; Z = 0.01 + 0.03. Base = (0.60 + Z, -0.05 - Y, X).
+  // TCP Y = right - BW/2; X = -0.32 (lower_shelf.drop_m) + height + 0.005; Z = 0.01 + 0.03. Base = (0.60 + Z, -0.05 - Y, X).
   const double ys[3] = {0.37 - 0.0125, 0.34 - 0.010, 0.315 - 0.015};
   const double hs[3] = {0.25, 0.18, 0.22};
   for (int i = 0; i < 3; ++i) {
     const Eigen::Vector3d tcp = w.lower[i].second.translation();
     EXPECT_NEAR(tcp.x(), 0.64, 0.0015) << "book " << i;
     EXPECT_NEAR(tcp.y(), -0.05 - ys[i], 0.0015) << "book " << i;
-    EXPECT_NEAR(tcp.z(), -0.35 + hs[i] + 0.005, 0.0015) << "book " << i;
+    EXPECT_NEAR(tcp.z(), -0.32 + hs[i] + 0.005, 0.0015) << "book " << i;
   }
   // Holder: support origin (0.301, 0.28, -0.09), base axes; TCP (-0.02, 0.215, h + 0.005) in it.
   ASSERT_EQ(w.holder_drops.size(), 3u);
