@@ -1,0 +1,125 @@
+// The segmentation comparison: the true-depth disparity source, tolerances, GoD on a rendered scene
+// against the simulator's ground truth, and the bookgrasp_eval_segmentation tool end to end.
+#include "services/eval_segmentation/segmentation_eval.h"
+
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include <gtest/gtest.h>
+#include <yaml-cpp/yaml.h>
+
+namespace bookgrasp::eval_segmentation {
+namespace {
+
+const std::string kSrc = BOOKGRASP_SOURCE_DIR;
+
+TEST(SegmentationEval, TrueDisparityIsFocalTimesBaselineOverDepth) {
+  cv::Mat z = (cv::Mat_<float>(1, 4) << 1.0f, 2.0f, std::nanf(""), 0.0f);
+  const cv::Mat d = true_disparity(z, 600.0, 0.1, 0.0, 0.0, 7);
+  EXPECT_FLOAT_EQ(d.at<float>(0, 0), 60.0f);
+  EXPECT_FLOAT_EQ(d.at<float>(0, 1), 30.0f);
+  EXPECT_TRUE(std::isnan(d.at<float>(0, 2)));
+  EXPECT_TRUE(std::isnan(d.at<float>(0, 3)));
+  // 1/16 px rounding: 600 * 0.1 / 1.7 = 35.294... -> 35.3125.
+  const cv::Mat q = true_disparity(cv::Mat(1, 1, CV_32F, cv::Scalar(1.7f)), 600.0, 0.1, 0.0, 1.0 / 16, 7);
+  EXPECT_FLOAT_EQ(q.at<float>(0, 0), 35.3125f);
+  EXPECT_THROW(true_disparity(z, 0.0, 0.1, 0.0, 0.0, 1), std::invalid_argument);
+  EXPECT_THROW(true_disparity(cv::Mat(1, 1, CV_64F), 600, 0.1, 0.0, 0.0, 1), std::invalid_argument);
+}
+
+TEST(SegmentationEval, TrueDisparityNoiseHasTheAskedSpreadAndIsSeeded) {
+  const cv::Mat z(200, 200, CV_32F, cv::Scalar(2.0f));
+  const cv::Mat a = true_disparity(z, 600.0, 0.1, 0.2, 0.0, 5), b = true_disparity(z, 600.0, 0.1, 0.2, 0.0, 5);
+  EXPECT_EQ(cv::norm(a, b, cv::NORM_INF), 0.0);
+  cv::Scalar mean, sd;
+  cv::meanStdDev(a, mean, sd);
+  EXPECT_NEAR(mean[0], 30.0, 0.01);
+  EXPECT_NEAR(sd[0], 0.2, 0.01);
+  EXPECT_GT(cv::norm(a, true_disparity(z, 600.0, 0.1, 0.2, 0.0, 6), cv::NORM_INF), 0.0);
+}
+
+TEST(SegmentationEval, ToleranceKeysAndTheHalfCase) {
+  EXPECT_EQ(tolerance_key(0.5), "T0.5");
+  EXPECT_EQ(tolerance_key(0.8), "T0.8");
+  EXPECT_GT(effective_tolerance(0.5), 0.5);
+  EXPECT_LT(effective_tolerance(0.5), 0.50001);
+  EXPECT_EQ(effective_tolerance(0.9), 0.9);
+}
+
+// GoD (bws_detector's configuration) on the exact-depth range image of seed 3: the right-most book's front,
+// a ground-truth region from the simulator's geometry, is a correct detection at T = 0.8. This holds in 4 of
+// seeds 1-30 only (GoD merges coplanar neighbouring fore-edges: under-segmentation, docs/BWS.md); seed 3 is
+// one of them, so this guards that behaviour, it is not a rate.
+TEST(SegmentationEval, GodDetectsTheRightmostFrontOnSeed3) {
+  RangeSceneOptions o;
+  o.scene_file = kSrc + "/config/scenes/default.yaml";
+  o.seed = 3;
+  const RangeScene s = render_range_scene(o);
+  EvalConfig c = EvalConfig::from_files(kSrc + "/config/services/bws_detector.yaml",
+                                        kSrc + "/config/services/bws_detector_pcl.yaml");
+  c.stereo = false;
+  c.true_noise_px = 0.0;
+  c.tolerances = {0.8};
+  const SceneEval e = evaluate_scene(s, 3, c);
+  const int front = s.rightmost_front_label();
+  ASSERT_GT(front, 0);
+  ASSERT_EQ(e.runs.front().name, "god");
+  EXPECT_EQ(e.runs.front().hoover.at(0).gt_class_of(front), HooverClass::kCorrect);
+}
+
+// The tool on 2 scenes: metrics.json has methods.<name>.T<tol>.{correct,over,under,missed,noise}, every
+// fraction in [0, 1], the GT-side fractions add up to 1 (rounding: 4 decimals), correct detections do
+// not increase with T; report.md and the scene picture exist.
+TEST(SegmentationEval, ToolWritesConsistentMetrics) {
+  const std::string out = (std::filesystem::temp_directory_path() / "bookgrasp_eval_segmentation_test").string();
+  std::filesystem::remove_all(out);
+  const std::string tool =
+      std::string(BOOKGRASP_BINARY_DIR) + "/services/eval_segmentation/bookgrasp_eval_segmentation";
+  const std::string cmd = tool + " --out " + out + " --scenes 2 --seed 4 --pictures 1 2>/dev/null >/dev/null";
+  ASSERT_EQ(std::system(cmd.c_str()), 0) << cmd;
+  const YAML::Node m = YAML::LoadFile(out + "/metrics.json");
+  EXPECT_EQ(m["scenes"].as<int>(), 2);
+  EXPECT_GT(m["gt_regions"].as<int>(), 20);
+  EXPECT_GE(m["curved_gt_regions"].as<int>(), 1);
+  const char* methods[] = {"god", "pcl", "jump", "god_stereo", "pcl_stereo", "jump_stereo"};
+  const char* tols[] = {"T0.5", "T0.6", "T0.7", "T0.8", "T0.9"};
+  for (const char* name : methods) {
+    ASSERT_TRUE(m["methods"][name]) << name;
+    double prev_correct = 2.0;
+    for (const char* t : tols) {
+      const YAML::Node r = m["methods"][name][t];
+      ASSERT_TRUE(r) << name << " " << t;
+      double sum = 0;
+      for (const char* k : {"correct", "over", "under", "missed"}) {
+        const double v = r[k].as<double>();
+        EXPECT_GE(v, 0.0) << name << t << k;
+        EXPECT_LE(v, 1.0) << name << t << k;
+        sum += v;
+      }
+      EXPECT_NEAR(sum, 1.0, 5e-4) << name << " " << t;
+      EXPECT_GE(r["noise"].as<double>(), 0.0);
+      EXPECT_LE(r["noise"].as<double>(), 1.0);
+      EXPECT_LE(r["correct"].as<double>(), prev_correct + 1e-9) << name << " " << t;
+      prev_correct = r["correct"].as<double>();
+      const YAML::Node n = r["counts"];
+      EXPECT_EQ(n["correct"].as<int>() + n["over"].as<int>() + n["under_gt_regions"].as<int>() + n["missed"].as<int>(),
+                n["gt_regions"].as<int>());
+    }
+  }
+  std::ifstream report(out + "/report.md");
+  std::stringstream text;
+  text << report.rdbuf();
+  EXPECT_NE(text.str().find("| 0.8 |"), std::string::npos);
+  EXPECT_NE(text.str().find("73"), std::string::npos);
+  EXPECT_TRUE(std::filesystem::exists(out + "/scene_4.png"));
+  EXPECT_FALSE(std::filesystem::exists(out + "/scene_5.png"));
+  // Bad arguments: a clear refusal, not a crash.
+  EXPECT_NE(std::system((tool + " --scenes 0 --out " + out + " 2>/dev/null").c_str()), 0);
+  EXPECT_NE(std::system((tool + " --scenes 1 2>/dev/null").c_str()), 0);
+}
+
+}  // namespace
+}  // namespace bookgrasp::eval_segmentation
