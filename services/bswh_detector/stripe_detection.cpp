@@ -27,6 +27,12 @@ StripeDetectionParams StripeDetectionParams::from_config(const Config& cfg) {
   p.canny_high = cfg.get_double("canny_high", 1.0, 1000.0);
   p.border_margin_px = cfg.get_int("border_margin_px", 0, 100);
   p.end_side = cfg.get_choice("end_side", {"left", "right"});
+  // Robustness keys (added later): optional, the defaults keep the earlier behaviour.
+  if (cfg.has("ignore_bottom_rows")) p.ignore_bottom_rows = cfg.get_int("ignore_bottom_rows", 0, 4096);
+  if (cfg.has("reject_touching_bottom")) p.reject_touching_bottom = cfg.get<bool>("reject_touching_bottom");
+  if (cfg.has("min_band_fill")) p.min_band_fill = cfg.get_double("min_band_fill", 0.0, 1.0);
+  if (cfg.has("expected_row_px")) p.expected_row_px = cfg.get_double("expected_row_px", -1.0, 10000.0);
+  if (cfg.has("max_row_offset_px")) p.max_row_offset_px = cfg.get_double("max_row_offset_px", 1.0, 1e9);
   return p;
 }
 
@@ -102,6 +108,8 @@ StripeDetection detect_stripe(const cv::Mat& image, const StripeDetectionParams&
   background.convertTo(threshold, CV_8U, p.dark_ratio);
   cv::Mat dark = (smooth < threshold) & (smooth < p.max_dark_value);
   const int run = std::max(5, std::min(p.min_length_px, 41) / 2 * 2 + 1);
+  const int usable_rows = std::max(1, v.rows - p.ignore_bottom_rows);
+  if (usable_rows < v.rows) dark.rowRange(usable_rows, v.rows).setTo(0);
   cv::morphologyEx(dark, dark, cv::MORPH_OPEN, cv::getStructuringElement(cv::MORPH_RECT, cv::Size(run, 1)));
 
   cv::Mat labels, stats, centroids;
@@ -115,6 +123,10 @@ StripeDetection detect_stripe(const cv::Mat& image, const StripeDetectionParams&
     if (bw < p.min_length_px) {
       last_reject = "darkest horizontal region is only " + std::to_string(bw) + " px long (min_length_px " +
                     std::to_string(p.min_length_px) + ")";
+      continue;
+    }
+    if (p.reject_touching_bottom && by + bh >= usable_rows - 1) {
+      last_reject = "dark horizontal region touches the image bottom (a shadow on the shelf or the fingers)";
       continue;
     }
     std::vector<int> count(static_cast<size_t>(bw), 0);
@@ -146,8 +158,8 @@ StripeDetection detect_stripe(const cv::Mat& image, const StripeDetectionParams&
     Segment s;
     if (!fit_line_y_of_x(centres, &s.slope, &s.intercept)) continue;
     if (std::abs(s.slope) > max_tan) {
-      last_reject = "dark region at angle " + std::to_string(std::atan(s.slope) * 180 / CV_PI) +
-                    " deg exceeds max_angle_deg";
+      last_reject =
+          "dark region at angle " + std::to_string(std::atan(s.slope) * 180 / CV_PI) + " deg exceeds max_angle_deg";
       continue;
     }
     s.vertical_thickness = median;
@@ -161,6 +173,19 @@ StripeDetection detect_stripe(const cv::Mat& image, const StripeDetectionParams&
     s.x_max = x_max;
     s.length = static_cast<int>(centres.size());
     if (s.length < p.min_length_px) continue;
+    if (s.length < p.min_band_fill * bw) {
+      last_reject = "dark region is not a band: " + std::to_string(s.length) + " of " + std::to_string(bw) +
+                    " columns have the band's thickness (min_band_fill)";
+      continue;
+    }
+    if (p.expected_row_px >= 0) {
+      const double row = s.slope * 0.5 * (v.cols - 1) + s.intercept;
+      if (std::abs(row - p.expected_row_px) > p.max_row_offset_px) {
+        last_reject = "dark horizontal band at row " + std::to_string(static_cast<int>(std::lround(row))) +
+                      ", more than max_row_offset_px from expected_row_px";
+        continue;
+      }
+    }
     segments.push_back(s);
   }
   if (segments.empty()) {
@@ -191,15 +216,16 @@ StripeDetection detect_stripe(const cv::Mat& image, const StripeDetectionParams&
   const double yc = best.slope * x0 + best.intercept;
   const double half = std::max(1.0, 0.3 * best.vertical_thickness);
   const int w = static_cast<int>(std::max(6.0, best.vertical_thickness));
-  const cv::Rect roi = cv::Rect(x0 - w - 2, static_cast<int>(std::floor(yc - half)) - 2, 2 * w + 5,
-                                static_cast<int>(2 * half) + 6) &
-                       cv::Rect(0, 0, v.cols, v.rows);
+  const cv::Rect roi =
+      cv::Rect(x0 - w - 2, static_cast<int>(std::floor(yc - half)) - 2, 2 * w + 5, static_cast<int>(2 * half) + 6) &
+      cv::Rect(0, 0, v.cols, v.rows);
   std::vector<cv::Point2d> edge_points;
   if (roi.width > 4 && roi.height > 4) {
     cv::Mat patch;
     if (p.edge_sigma_px > 0) {
       // Blur a slightly larger window so the patch has no border artefacts.
-      const cv::Rect outer = cv::Rect(roi.x - 4, roi.y - 4, roi.width + 8, roi.height + 8) & cv::Rect(0, 0, v.cols, v.rows);
+      const cv::Rect outer =
+          cv::Rect(roi.x - 4, roi.y - 4, roi.width + 8, roi.height + 8) & cv::Rect(0, 0, v.cols, v.rows);
       cv::Mat blurred;
       cv::GaussianBlur(v(outer), blurred, cv::Size(0, 0), p.edge_sigma_px);
       patch = blurred(cv::Rect(roi.x - outer.x, roi.y - outer.y, roi.width, roi.height)).clone();

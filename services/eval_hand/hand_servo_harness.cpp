@@ -1,6 +1,7 @@
 #include "services/eval_hand/hand_servo_harness.h"
 
 #include <chrono>
+#include <cstdio>
 #include <filesystem>
 #include <memory>
 #include <stdexcept>
@@ -110,6 +111,9 @@ void save_debug(const HandServoOptions& o, const std::string& tag, const hand_im
                 const book_features_hand_t* book, const stripe_features_t* stripe) {
   if (o.debug_image_dir.empty()) return;
   std::filesystem::create_directories(o.debug_image_dir);
+  cv::Mat raw;
+  cv::cvtColor(image_to_mat(img.image), raw, cv::COLOR_RGB2BGR);
+  cv::imwrite((std::filesystem::path(o.debug_image_dir) / (o.debug_prefix + tag + "_raw.png")).string(), raw);
   cv::imwrite((std::filesystem::path(o.debug_image_dir) / (o.debug_prefix + tag + ".png")).string(),
               overlay(img, truth, book, stripe));
 }
@@ -223,9 +227,17 @@ HandServoResult run_hand_servo_task(const scene::Scene& scene_in, const HandServ
   comp.spin();
   const int64_t t_request = t;
   bool first_saved = false;
+  int last_dumped = -1;
   const int64_t t_end = t + static_cast<int64_t>((task.timeout_s + 2.0) * 1e6);
   while (t < t_end) {
     advance(t += step);
+    if (options.debug_every_frames > 0 && sink.have_image && sink.frames != last_dumped &&
+        sink.frames % options.debug_every_frames == 0) {
+      last_dumped = sink.frames;
+      char tag[32];
+      std::snprintf(tag, sizeof tag, "f%04d", sink.frames);
+      save_debug(options, tag, sink.last_image, world.model().ground_truth(t), &sink.last_book, &sink.last_stripe);
+    }
     if (!first_saved && sink.have_image) {
       save_debug(options, "first", sink.last_image, world.model().ground_truth(t), &sink.last_book, &sink.last_stripe);
       first_saved = true;

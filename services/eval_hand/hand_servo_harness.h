@@ -33,39 +33,40 @@ namespace bookgrasp {
 
 /// What to run.
 struct HandServoTask {
-  int mode = 1;                      ///< servo_request_t::BOOK_CORNER (1) or STRIPE_END (2)
+  int mode = 1;                                                 ///< servo_request_t::BOOK_CORNER (1) or STRIPE_END (2)
   Eigen::Isometry3d start_tcp = Eigen::Isometry3d::Identity();  ///< start pose of the TCP in base
-  double standoff_m = 0.2;           ///< SERVO_REQUEST.fixed_depth_m
-  double timeout_s = 20.0;           ///< SERVO_REQUEST.timeout_s (simulation time)
+  double standoff_m = 0.2;                                      ///< SERVO_REQUEST.fixed_depth_m
+  double timeout_s = 20.0;                                      ///< SERVO_REQUEST.timeout_s (simulation time)
   int rank_from_right = 0;
 };
 
 /// Harness options.
 struct HandServoOptions {
-  std::string config_dir;            ///< folder with the services' YAML files (config/services)
-  double camera_rate_hz = 15.0;      ///< hand camera frames per second of simulation time
-  std::string debug_image_dir;       ///< if set: first and last hand image of the task (PNG) go here
-  std::string debug_prefix;          ///< file name prefix of the debug images
+  std::string config_dir;                 ///< folder with the services' YAML files (config/services)
+  double camera_rate_hz = 15.0;           ///< hand camera frames per second of simulation time
+  std::string debug_image_dir;            ///< if set: first and last hand image of the task (PNG) go here
+  std::string debug_prefix;               ///< file name prefix of the debug images
+  int debug_every_frames = 0;             ///< with debug_image_dir: also every this many frames (0 = first/last only)
   std::optional<bool> require_occlusion;  ///< overrides visual_servo stripe_end.require_occlusion
   std::optional<std::string> search_direction;  ///< overrides stripe_end.search_direction ("right"/"left")
 };
 
 /// What happened.
 struct HandServoResult {
-  bool ik_ok = false;                ///< the start pose was reachable
+  bool ik_ok = false;  ///< the start pose was reachable
   std::string ik_message;
-  int state = 0;                     ///< final servo_status_t state (0 = none reported)
-  std::string message;               ///< its message
+  int state = 0;        ///< final servo_status_t state (0 = none reported)
+  std::string message;  ///< its message
   int iterations = 0;
-  double sim_time_s = 0;             ///< request to final status, simulation time
-  double wall_time_s = 0;            ///< the whole task (build + run)
-  std::optional<Eigen::Isometry3d> converged_pose;  ///< CONVERGED: the TCP pose (P2 or PS)
-  ground_truth_t truth;              ///< ground truth at the end of the task
-  std::vector<double> bwh_ms, bswh_ms;  ///< detector processing time per frame
-  int frames = 0;                    ///< hand images rendered during the task
-  cv::Mat last_image;                ///< last hand image (RGB)
+  double sim_time_s = 0;                                                  ///< request to final status, simulation time
+  double wall_time_s = 0;                                                 ///< the whole task (build + run)
+  std::optional<Eigen::Isometry3d> converged_pose;                        ///< CONVERGED: the TCP pose (P2 or PS)
+  ground_truth_t truth;                                                   ///< ground truth at the end of the task
+  std::vector<double> bwh_ms, bswh_ms;                                    ///< detector processing time per frame
+  int frames = 0;                                                         ///< hand images rendered during the task
+  cv::Mat last_image;                                                     ///< last hand image (RGB)
   Eigen::Isometry3d last_camera_in_base = Eigen::Isometry3d::Identity();  ///< its camera pose
-  bool last_book_found = false;      ///< BwH result on the last image
+  bool last_book_found = false;                                           ///< BwH result on the last image
   Eigen::Vector2d last_r_px = Eigen::Vector2d::Zero();
   bool last_stripe_end_found = false;  ///< BSwH result on the last image
   Eigen::Vector2d last_stripe_end_px = Eigen::Vector2d::Zero();

@@ -15,6 +15,7 @@ void StripeEndServo::reset() {
   phase_ = StripePhase::kSearch;
   occlusion_seen_ = false;
   in_tolerance_ = 0;
+  missing_in_track_ = 0;
 }
 
 StripeServoStep StripeEndServo::step(const StripeObservation& obs, double standoff_m, double travelled_m) {
@@ -23,9 +24,8 @@ StripeServoStep StripeEndServo::step(const StripeObservation& obs, double stando
   const double ut = out.target_px.x();
 
   if (phase_ == StripePhase::kSearch) {
-    const bool covers_target =
-        obs.found && ut >= std::min(obs.line_start_px.x(), obs.line_end_px.x()) - 1.0 &&
-        ut <= std::max(obs.line_start_px.x(), obs.line_end_px.x()) + 1.0;
+    const bool covers_target = obs.found && ut >= std::min(obs.line_start_px.x(), obs.line_end_px.x()) - 1.0 &&
+                               ut <= std::max(obs.line_start_px.x(), obs.line_end_px.x()) + 1.0;
     if (!covers_target) occlusion_seen_ = true;
     // An end is the left end of the right-most visible segment (BSwH, end_side left). Before
     // the books have hidden the stripe (require_occlusion), ends are ignored: they may be a
@@ -39,11 +39,13 @@ StripeServoStep StripeEndServo::step(const StripeObservation& obs, double stando
     if (accept) {
       phase_ = StripePhase::kTrack;
       in_tolerance_ = 0;
+      missing_in_track_ = 0;
     } else {
       if (travelled_m > p_.max_search_distance_m) {
         out.failed = true;
         char buf[160];
-        std::snprintf(buf, sizeof(buf), "no stripe end found after %.2f m of search along the stripe (max_search_distance_m %.2f)",
+        std::snprintf(buf, sizeof(buf),
+                      "no stripe end found after %.2f m of search along the stripe (max_search_distance_m %.2f)",
                       travelled_m, p_.max_search_distance_m);
         out.note = buf;
         return out;
@@ -77,11 +79,22 @@ StripeServoStep StripeEndServo::step(const StripeObservation& obs, double stando
   // TRACK
   out.phase = phase_;
   if (!obs.end_found) {
+    ++missing_in_track_;
+    if (p_.track_lost_frames > 0 && missing_in_track_ >= p_.track_lost_frames) {
+      // The end was not the stripe's end (seen through a gap, or a false detection): search on.
+      phase_ = StripePhase::kSearch;
+      in_tolerance_ = 0;
+      missing_in_track_ = 0;
+      StripeServoStep s = step(obs, standoff_m, travelled_m);
+      s.note = "end lost while tracking, searching again; " + s.note;
+      return s;
+    }
     out.measured = false;
     in_tolerance_ = 0;
     out.note = obs.found ? "stripe seen but its end is outside the image" : "stripe not visible";
     return out;
   }
+  missing_in_track_ = 0;
   out.error_px = obs.end_px - out.target_px;
   Eigen::Vector3d p;
   if (!geo_.pixel_on_plane(obs.end_px, standoff_m, &p)) {

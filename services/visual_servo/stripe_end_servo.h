@@ -36,24 +36,27 @@ namespace bookgrasp {
 
 /// Parameters of the stripe servo (from configuration).
 struct StripeEndServoParams {
-  double gain = 1.0;                  ///< 1/s on the metric position error (TRACK)
-  double max_linear_speed = 0.05;     ///< m/s while tracking
-  double search_speed = 0.1;          ///< m/s along the stripe while searching
-  int search_direction = +1;          ///< while the stripe is hidden: +1 = gripper +y (right as seen from the robot), -1 = left
-  int end_side_direction = -1;        ///< where the end lies from a visible segment whose end is outside the image
-                                      ///< (BSwH end_side: left = -1, right = +1)
-  bool require_occlusion = true;      ///< accept an end only after the stripe was hidden at the target column
-  double converged_x_m = 0.0015;      ///< |error up| below this ...
-  double converged_y_m = 0.0015;      ///< ... and |error right| below this ...
-  int converged_frames = 3;           ///< ... on this many consecutive measurements
-  double max_search_distance_m = 1.0; ///< give up the search after this much travel
+  double gain = 1.0;               ///< 1/s on the metric position error (TRACK)
+  double max_linear_speed = 0.05;  ///< m/s while tracking
+  double search_speed = 0.1;       ///< m/s along the stripe while searching
+  int search_direction = +1;  ///< while the stripe is hidden: +1 = gripper +y (right as seen from the robot), -1 = left
+  int end_side_direction = -1;         ///< where the end lies from a visible segment whose end is outside the image
+                                       ///< (BSwH end_side: left = -1, right = +1)
+  bool require_occlusion = true;       ///< accept an end only after the stripe was hidden at the target column
+  double converged_x_m = 0.0015;       ///< |error up| below this ...
+  double converged_y_m = 0.0015;       ///< ... and |error right| below this ...
+  int converged_frames = 3;            ///< ... on this many consecutive measurements
+  double max_search_distance_m = 1.0;  ///< give up the search after this much travel
+  int track_lost_frames = 0;           ///< TRACK: the end missing on this many consecutive observations -> back to
+                                       ///< SEARCH (an end seen through a gap between books disappears as the
+                                       ///< camera moves); 0 = never (the session reports FEATURE_LOST)
 };
 
 /// What BSwH saw in one image (the fields of stripe_features_t the servo uses).
 struct StripeObservation {
-  bool found = false;               ///< a stripe segment is visible
-  bool end_found = false;           ///< its end is inside the image
-  Eigen::Vector2d end_px = Eigen::Vector2d::Zero();      ///< stripe end
+  bool found = false;                                       ///< a stripe segment is visible
+  bool end_found = false;                                   ///< its end is inside the image
+  Eigen::Vector2d end_px = Eigen::Vector2d::Zero();         ///< stripe end
   Eigen::Vector2d line_start_px = Eigen::Vector2d::Zero();  ///< centre line, left end of the visible segment
   Eigen::Vector2d line_end_px = Eigen::Vector2d::Zero();    ///< centre line, right end
 };
@@ -98,6 +101,7 @@ class StripeEndServo {
   StripePhase phase_ = StripePhase::kSearch;
   bool occlusion_seen_ = false;
   int in_tolerance_ = 0;
+  int missing_in_track_ = 0;
 };
 
 }  // namespace bookgrasp

@@ -16,7 +16,9 @@ std::string resolve(const std::string& p) {
   return (std::filesystem::path(kSourceDir) / p).string();
 }
 
-int direction(const Config& c, const std::string& key) { return c.get_choice(key, {"right", "left"}) == "right" ? 1 : -1; }
+int direction(const Config& c, const std::string& key) {
+  return c.get_choice(key, {"right", "left"}) == "right" ? 1 : -1;
+}
 
 }  // namespace
 
@@ -73,6 +75,7 @@ VisualServoSettings VisualServoSettings::from_config(const Config& root) {
   s.stripe.converged_y_m = st.get_double("converged_y_m", 1e-5, 0.1);
   s.stripe.converged_frames = st.get_int("converged_frames", 1, 1000);
   s.stripe.max_search_distance_m = st.get_double("max_search_distance_m", 0.01, 10);
+  if (st.has("track_lost_frames")) s.stripe.track_lost_frames = st.get_int("track_lost_frames", 0, 1000);
   return s;
 }
 
@@ -144,8 +147,8 @@ void VisualServoNode::on_request(const servo_request_t& msg) {
   }
   if (!msg.start_pose.frame.empty()) {
     if (msg.start_pose.frame != "base") {
-      reject(settings_.servo_request_channel, "start_pose.frame must be 'base' (or empty for 'where the arm is'), got '" +
-                                                  msg.start_pose.frame + "'");
+      reject(settings_.servo_request_channel,
+             "start_pose.frame must be 'base' (or empty for 'where the arm is'), got '" + msg.start_pose.frame + "'");
       return;
     }
     if (!is_valid_pose(msg.start_pose)) {

@@ -6,8 +6,8 @@
 
 #include <random>
 
-#include "servo_plant.h"
 #include "services/visual_servo/stripe_end_servo.h"
+#include "servo_plant.h"
 
 namespace bookgrasp {
 namespace {
@@ -129,6 +129,45 @@ TEST(StripeEndServo, AnEndBeforeTheOcclusionIsNotAccepted) {
   EXPECT_EQ(s.phase, StripePhase::kTrack);
   EXPECT_TRUE(servo.occlusion_seen());
   EXPECT_GT(s.error_px.x(), 0.0);
+}
+
+TEST(StripeEndServo, AnEndThatVanishesWhileTrackingSendsTheSearchOn) {
+  // An end seen through a gap between books (right of the target after the occlusion) is tracked,
+  // then disappears: after track_lost_frames observations without an end the search goes on.
+  const HandEyeGeometry g = test::project_geometry();
+  StripeEndServoParams p = params();
+  p.track_lost_frames = 3;
+  StripeEndServo servo(g, p);
+  StripeObservation hidden;  // stripe hidden at the target column: occlusion seen
+  StripeServoStep s = servo.step(hidden, 0.5, 0.0);
+  ASSERT_TRUE(servo.occlusion_seen());
+  StripeObservation gap;
+  gap.found = gap.end_found = true;
+  gap.end_px = gap.line_start_px = {420, 300};
+  gap.line_end_px = {470, 300};
+  s = servo.step(gap, 0.5, 0.01);
+  ASSERT_EQ(s.phase, StripePhase::kTrack);
+  for (int i = 0; i < 2; ++i) {
+    s = servo.step(hidden, 0.5, 0.02);
+    EXPECT_EQ(s.phase, StripePhase::kTrack) << i;
+    EXPECT_FALSE(s.measured) << i;  // the session holds, then reports FEATURE_LOST if it stays so
+  }
+  s = servo.step(hidden, 0.5, 0.03);
+  EXPECT_EQ(s.phase, StripePhase::kSearch);
+  EXPECT_TRUE(s.measured);
+  EXPECT_GT(s.twist(1), 0.0);  // on in the search direction
+  EXPECT_NE(s.note.find("searching again"), std::string::npos) << s.note;
+
+  // With track_lost_frames 0 the end stays lost (the session's FEATURE_LOST).
+  p.track_lost_frames = 0;
+  StripeEndServo strict(g, p);
+  strict.step(hidden, 0.5, 0.0);
+  ASSERT_EQ(strict.step(gap, 0.5, 0.01).phase, StripePhase::kTrack);
+  for (int i = 0; i < 10; ++i) {
+    s = strict.step(hidden, 0.5, 0.02);
+    EXPECT_EQ(s.phase, StripePhase::kTrack);
+    EXPECT_FALSE(s.measured);
+  }
 }
 
 }  // namespace
