@@ -82,11 +82,35 @@ struct SceneEval {
   cv::Mat disparity_true, disparity_stereo;
   /// Fraction of GT-labelled pixels with a valid stereo disparity.
   double stereo_coverage = 0.0;
+  /// Median |stereo - exact disparity| over those pixels, px (NaN if none): checks the stereo path.
+  double stereo_median_error_px = 0.0;
   /// Method runs (true source first, then stereo).
   std::vector<MethodRun> runs;
   /// GT label of the right-most book's front (0 if not a GT region).
   int rightmost_front_label = 0;
+  /// Category (GtCategory) of every GT region, index label - 1.
+  std::vector<int> gt_category;
 };
+
+/// Kinds of ground-truth regions, for the breakdown of the results.
+enum GtCategory : int {
+  /// A book's fore-edge (front) face.
+  kBookFront = 0,
+  /// Any other face of a book (sides, top).
+  kBookOther = 1,
+  /// A curved surface (cup mantle, ball, robot mesh).
+  kCurved = 2,
+  /// Every other planar surface (cart boards, holder, screen, floor, walls, cup top).
+  kOtherPlanar = 3,
+  /// Number of categories.
+  kNumCategories = 4,
+};
+
+/// Name of a category: "book_front", "book_other", "curved", "other_planar".
+const char* gt_category_name(int category);
+
+/// Category of a ground-truth region.
+int gt_category_of(const GtRegion& region);
 
 /// Runs every method on both sources of `scene` and compares with its ground truth.
 SceneEval evaluate_scene(const RangeScene& scene, uint64_t seed, const EvalConfig& config);
@@ -103,6 +127,9 @@ struct MethodSummary {
   int rightmost_front_correct = 0;
   /// Scenes where the right-most book's front is a GT region.
   int rightmost_front_scenes = 0;
+  /// GT regions per category and those correctly detected at T = 0.8.
+  std::vector<long long> category_regions = std::vector<long long>(kNumCategories, 0),
+                         category_correct = std::vector<long long>(kNumCategories, 0);
 };
 
 /// Summaries of every method (in the order of the runs).

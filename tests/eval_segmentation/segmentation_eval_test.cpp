@@ -41,6 +41,22 @@ TEST(SegmentationEval, TrueDisparityNoiseHasTheAskedSpreadAndIsSeeded) {
   EXPECT_GT(cv::norm(a, true_disparity(z, 600.0, 0.1, 0.2, 0.0, 6), cv::NORM_INF), 0.0);
 }
 
+TEST(SegmentationEval, GroundTruthCategories) {
+  GtRegion r;
+  r.owner = 3;
+  r.name = "book_3_pages:+z";
+  EXPECT_EQ(gt_category_of(r), kBookFront);
+  r.name = "book_3:+y";
+  EXPECT_EQ(gt_category_of(r), kBookOther);
+  r.owner = -2;
+  r.name = "cart_rear_board:-x";
+  EXPECT_EQ(gt_category_of(r), kOtherPlanar);
+  r.planar = false;
+  r.name = "evalseg_ball:sphere";
+  EXPECT_EQ(gt_category_of(r), kCurved);
+  EXPECT_STREQ(gt_category_name(kBookFront), "book_front");
+}
+
 TEST(SegmentationEval, ToleranceKeysAndTheHalfCase) {
   EXPECT_EQ(tolerance_key(0.5), "T0.5");
   EXPECT_EQ(tolerance_key(0.8), "T0.8");
@@ -108,6 +124,14 @@ TEST(SegmentationEval, ToolWritesConsistentMetrics) {
       EXPECT_EQ(n["correct"].as<int>() + n["over"].as<int>() + n["under_gt_regions"].as<int>() + n["missed"].as<int>(),
                 n["gt_regions"].as<int>());
     }
+    // The categories partition the GT regions; their correct detections add up to the T = 0.8 count.
+    long long regions = 0, correct = 0;
+    for (const auto& kv : m["methods"][name]["correct_by_category_T0.8"]) {
+      regions += kv.second["gt_regions"].as<long long>();
+      correct += kv.second["correct"].as<long long>();
+    }
+    EXPECT_EQ(regions, m["gt_regions"].as<long long>()) << name;
+    EXPECT_EQ(correct, m["methods"][name]["T0.8"]["counts"]["correct"].as<long long>()) << name;
   }
   std::ifstream report(out + "/report.md");
   std::stringstream text;
