@@ -1,9 +1,12 @@
-// Tests of the BSwH core on synthetic hand images with known stripe end.
+// Tests of the BSwH core on synthetic hand images with known stripe end, and on rendered (simulated)
+// hand images of the eval scene with the gripper fingers and the cart's side-panel shadow in view.
 #include <cmath>
 #include <cstdlib>
 #include <string>
 
 #include <gtest/gtest.h>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 
 #include "../bwh_detector/synthetic_hand_image.h"
 #include "common/image_conversion.h"
@@ -90,7 +93,9 @@ TEST(StripeDetection, RandomScenesWithin2px) {
     for (auto& b : s.books) b.lean_deg = lean + rng.uniform(-0.5, 0.5);
     s.light_gradient = rng.uniform(0.0, 0.5);
     s.noise_sigma = rng.uniform(1.0, 4.0);
-    if (i % 2) s.shadows.push_back({{{0, rng.uniform(100.0, 250.0)}, {640, rng.uniform(200.0, 400.0)}, {640, 480}, {0, 480}}, 0.55, 1.5});
+    if (i % 2)
+      s.shadows.push_back(
+          {{{0, rng.uniform(100.0, 250.0)}, {640, rng.uniform(200.0, 400.0)}, {640, 480}, {0, 480}}, 0.55, 1.5});
     expect_end_within(s, "random" + std::to_string(i), 2.0);
   }
 }
@@ -144,6 +149,80 @@ TEST(StripeDetection, SameImageSameResult) {
   const StripeDetection a = detect_stripe(img, params()), b = detect_stripe(img, params());
   EXPECT_EQ(a.end.x, b.end.x);
   EXPECT_EQ(a.end.y, b.end.y);
+}
+
+// Rendered hand images (services/eval_hand/scenes/hand_eval.yaml, seed 1), made with
+// `build-hand/tests/eval_hand/hand_view_dump --stripe-start OUT 1 1` (station A) and `--stripe OUT 1 1`
+// (converged at B). Truth from the simulation: at A the right-most book's projected silhouette at the
+// stripe row (the stripe's visible end), at B the projected true stripe end (both printed by the tool).
+// Both views show the gripper fingers at the image bottom and the dark shadow of the cart's right side
+// panel; at A the shadow beside the right finger was taken for the stripe before the finger rows were
+// ignored and regions touching the bottom rejected.
+cv::Mat load_rendered(const std::string& name) {
+  const cv::Mat bgr = cv::imread(std::string(BOOKGRASP_SOURCE_DIR) + "/tests/bswh_detector/data/" + name);
+  if (bgr.empty()) return bgr;
+  cv::Mat rgb;
+  cv::cvtColor(bgr, rgb, cv::COLOR_BGR2RGB);
+  return rgb;
+}
+
+TEST(StripeDetectionRendered, FingersAndSidePanelShadowAreNotTheStripe) {
+  struct Case {
+    const char* file;
+    cv::Point2d truth;
+  };
+  for (const Case& c : {Case{"hand_eval_seed1_station_a.png", {225.45, 290.55}},
+                        Case{"hand_eval_seed1_converged.png", {319.55, 290.47}}}) {
+    const cv::Mat img = load_rendered(c.file);
+    ASSERT_FALSE(img.empty()) << c.file;
+    const StripeDetection d = detect_stripe(img, params());
+    ASSERT_TRUE(d.found) << c.file << ": " << d.failure_reason;
+    ASSERT_TRUE(d.end_found) << c.file << ": " << d.failure_reason;
+    EXPECT_LT(std::hypot(d.end.x - c.truth.x, d.end.y - c.truth.y), 2.0)
+        << c.file << ": detected (" << d.end.x << ", " << d.end.y << ") true (" << c.truth.x << ", " << c.truth.y
+        << ")";
+    EXPECT_LT(std::abs(d.centre_y_at(c.truth.x) - c.truth.y), 2.0) << c.file;
+  }
+}
+
+TEST(StripeDetectionRendered, WithoutTheRobustnessKeysTheShadowBesideTheFingerWins) {
+  // The same view with the earlier behaviour (no finger rows ignored, nothing rejected): documents
+  // what the keys are for, and that the rendered test above can fail.
+  StripeDetectionParams p = params();
+  p.ignore_bottom_rows = 0;
+  p.reject_touching_bottom = false;
+  p.min_band_fill = 0.0;
+  p.expected_row_px = -1;
+  const StripeDetection d = detect_stripe(load_rendered("hand_eval_seed1_station_a.png"), p);
+  ASSERT_TRUE(d.end_found);
+  EXPECT_GT(d.end.y, 440.0) << "the end is expected in the finger rows without the keys";
+}
+
+TEST(StripeDetectionRendered, FarFromTheExpectedRowNothingIsTaken) {
+  StripeDetectionParams p = params();
+  p.expected_row_px = 100;
+  p.max_row_offset_px = 40;
+  const StripeDetection d = detect_stripe(load_rendered("hand_eval_seed1_converged.png"), p);
+  EXPECT_FALSE(d.found);
+  EXPECT_FALSE(d.failure_reason.empty());
+  EXPECT_TRUE(detect_stripe(load_rendered("hand_eval_seed1_converged.png"), params()).found);
+}
+
+TEST(StripeDetectionConfig, RobustnessKeysAreOptionalAndChecked) {
+  const std::string base = std::string(
+      "blur_sigma_px: 1.2\nbackground_scale: 8\nbackground_kernel_px: 64\n"
+      "dark_ratio: 0.5\nmax_dark_value: 90\nmin_length_px: 40\nmin_thickness_px: 4\n"
+      "max_thickness_px: 80\nmax_angle_deg: 20\nedge_sigma_px: 0.7\ncanny_low: 15\n"
+      "canny_high: 40\nborder_margin_px: 3\nend_side: left\n");
+  const StripeDetectionParams p = StripeDetectionParams::from_config(Config::from_string(base, "test"));
+  EXPECT_EQ(p.ignore_bottom_rows, 0);
+  EXPECT_FALSE(p.reject_touching_bottom);
+  EXPECT_LT(p.expected_row_px, 0);
+  for (const char* bad : {"min_band_fill: 1.5", "ignore_bottom_rows: -1", "max_row_offset_px: 0", "expected_row_px: -5",
+                          "reject_touching_bottom: maybe"}) {
+    const Config c = Config::from_string(base + bad + "\n", "test");
+    EXPECT_THROW(StripeDetectionParams::from_config(c), ConfigError) << bad;
+  }
 }
 
 }  // namespace
