@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <fstream>
 #include <limits>
 #include <sstream>
 #include <stdexcept>
@@ -204,11 +205,20 @@ std::string metrics_json(const std::vector<SceneEval>& scenes, const EvalConfig&
     coverage += s.stereo_coverage;
   }
   std::sort(stereo_err.begin(), stereo_err.end());
+  // FNV-1a 64 of the scene file's bytes: which version of a file that others edit the numbers come from.
+  uint64_t h = 1469598103934665603ull;
+  {
+    std::ifstream f(scene_file, std::ios::binary);
+    char ch;
+    while (f.get(ch)) h = (h ^ uint64_t(uint8_t(ch))) * 1099511628211ull;
+  }
+  char hash[32];
+  std::snprintf(hash, sizeof hash, "%016llx", (unsigned long long)h);
   std::ostringstream j;
-  j << "{\n  \"scene_file\": \"" << scene_file << "\",\n  \"first_seed\": " << first_seed
-    << ",\n  \"scenes\": " << scenes.size() << ",\n  \"curved_objects\": " << (curved ? "true" : "false")
-    << ",\n  \"curved_objects_placed\": " << placed << ",\n  \"gt_regions\": " << gt
-    << ",\n  \"curved_gt_regions\": " << curved_gt << ",\n"
+  j << "{\n  \"scene_file\": \"" << scene_file << "\",\n  \"scene_file_fnv1a64\": \"" << hash
+    << "\",\n  \"first_seed\": " << first_seed << ",\n  \"scenes\": " << scenes.size()
+    << ",\n  \"curved_objects\": " << (curved ? "true" : "false") << ",\n  \"curved_objects_placed\": " << placed
+    << ",\n  \"gt_regions\": " << gt << ",\n  \"curved_gt_regions\": " << curved_gt << ",\n"
     << "  \"fractions\": \"correct, over, under, missed: fractions of ground-truth regions (under counts the GT "
        "regions inside an under-segmentation; correct+over+under+missed = 1); noise: fraction of machine regions\",\n"
     << "  \"sources\": {\"true\": \"exact rendered depth as disparity + N(0, " << c.true_noise_px << " px), rounded to "
