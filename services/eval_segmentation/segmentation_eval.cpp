@@ -371,7 +371,7 @@ cv::Mat scene_picture(const RangeScene& scene, const SceneEval& e) {
   std::vector<cv::Mat> row2 = {tile(disp_rgb(e.disparity_true), "true-depth disparity"),
                                e.disparity_stereo.empty()
                                    ? tile(cv::Mat(th, tw, CV_8UC3, cv::Scalar(255, 255, 255)), "")
-                                   : tile(disp_rgb(e.disparity_stereo), "StereoBM disparity")};
+                                   : tile(disp_rgb(e.disparity_stereo), "stereo (block matching) disparity")};
   for (const MethodRun& r : e.runs) (r.name.find("_stereo") == std::string::npos ? row1 : row2).push_back(run_tile(r));
   while (row2.size() < row1.size()) row2.push_back(tile(cv::Mat(th, tw, CV_8UC3, cv::Scalar(255, 255, 255)), ""));
   while (row1.size() < row2.size()) row1.push_back(tile(cv::Mat(th, tw, CV_8UC3, cv::Scalar(255, 255, 255)), ""));
