@@ -6,6 +6,7 @@
 #include <iostream>
 #include <sstream>
 
+#include "common/config_overrides.h"
 #include "common/lcm_url.h"
 #include "common/service_host.h"
 #include "common/time_source.h"
@@ -19,8 +20,10 @@ void on_signal(int) { g_stop = 1; }
 
 void print_help(const ServiceDescription& d) {
   std::cout << d.name << " - " << d.summary << "\n\n"
-            << "usage: " << d.name << " [--config FILE] [--lcm-url URL] [--check-config] [--help]\n\n"
+            << "usage: " << d.name << " [--config FILE] [--set KEY=VALUE]... [--lcm-url URL] [--check-config] [--help]\n\n"
             << "  --config FILE   YAML configuration (default: " << kSourceDir << "/" << d.default_config << ")\n"
+            << "  --set KEY=VALUE override one value of the configuration file (dotted key, YAML value),\n"
+            << "                  e.g. --set user.auto_done_after_s=5; only keys of the file can be set\n"
             << "  --lcm-url URL   bus URL; overrides service.lcm_url and $LCM_DEFAULT_URL\n"
             << "                  (default: " << kDefaultLcmUrl << ")\n"
             << "  --check-config  validate the configuration and exit (0 = valid)\n"
@@ -42,6 +45,7 @@ int run_service_main(int argc, char** argv, const ServiceDescription& d) {
   std::string config_path = std::string(kSourceDir) + "/" + d.default_config;
   std::string url_arg;
   bool check_only = false;
+  std::vector<std::string> overrides;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     auto value = [&](const char* flag) -> std::string {
@@ -56,6 +60,8 @@ int run_service_main(int argc, char** argv, const ServiceDescription& d) {
       return 0;
     } else if (a == "--config") {
       config_path = value("--config");
+    } else if (a == "--set") {
+      overrides.push_back(value("--set"));
     } else if (a == "--lcm-url") {
       url_arg = value("--lcm-url");
     } else if (a == "--check-config") {
@@ -68,11 +74,14 @@ int run_service_main(int argc, char** argv, const ServiceDescription& d) {
 
   std::unique_ptr<ServiceHost> host;
   try {
-    const Config root = Config::load_file(config_path);
+    std::ifstream probe(config_path);
+    if (!probe) throw ConfigError("config file '" + config_path + "' cannot be read: check the path given with --config");
+    const std::string text = apply_config_overrides(read_file(config_path), overrides, config_path);
+    const Config root = Config::from_string(text, config_path);
     ServiceSettings settings = ServiceSettings::from_config(root);
     auto component = d.factory(root);
     root.require_all_read();
-    host = std::make_unique<ServiceHost>(std::move(component), settings, read_file(config_path), config_path);
+    host = std::make_unique<ServiceHost>(std::move(component), settings, text, config_path);
   } catch (const std::exception& e) {
     std::cerr << d.name << ": configuration error: " << e.what() << "\n";
     return 2;

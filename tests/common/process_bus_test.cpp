@@ -276,4 +276,32 @@ TEST_F(ProcessBus, BadConfigurationFailsAtStartNamingTheKey) {
   EXPECT_EQ(bad_arg.wait(5.0), 2);
 }
 
+TEST_F(ProcessBus, SetOverridesAConfigValueAndTheSnapshotCarriesIt) {
+  const std::string config = std::string(BOOKGRASP_SOURCE_DIR) + "/tests/common/echo.yaml";
+  // The output channel moved by --set: the echo answers on the new channel.
+  Child echo({ECHO_BINARY, "--config", config, "--set", "channels.output=ECHO_OUT_SET"}, url_);
+  std::vector<bookgrasp::task_status_t> moved;
+  struct Sink {
+    std::vector<bookgrasp::task_status_t>* out;
+    void on(const lcm::ReceiveBuffer*, const std::string&, const bookgrasp::task_status_t* m) { out->push_back(*m); }
+  } sink{&moved};
+  lcm_->subscribe("ECHO_OUT_SET", &Sink::on, &sink);
+  ASSERT_TRUE(spin_until([&] { return !listener_.status.empty(); }, 10.0)) << echo.output();
+  for (int i = 0; i < 5 && moved.empty(); ++i) {
+    const auto m = msg(1000 + i, "PING");
+    lcm_->publish("ECHO_IN", &m);
+    spin_until([&] { return !moved.empty(); }, 0.5);
+  }
+  ASSERT_FALSE(moved.empty()) << echo.output();
+  EXPECT_TRUE(listener_.echoed.empty()) << "the file's channel was used despite --set";
+
+  // An unknown key is an error at start naming it, exit code 2.
+  Child typo({ECHO_BINARY, "--config", config, "--set", "channels.outptu=X"}, url_);
+  EXPECT_EQ(typo.wait(5.0), 2);
+  EXPECT_NE(typo.output().find("'channels.outptu'"), std::string::npos) << typo.output();
+  Child malformed({ECHO_BINARY, "--config", config, "--set", "channels.output"}, url_);
+  EXPECT_EQ(malformed.wait(5.0), 2);
+  EXPECT_NE(malformed.output().find("dotted.key=value"), std::string::npos) << malformed.output();
+}
+
 }  // namespace

@@ -91,27 +91,39 @@ TEST(LibraryCycle, ThreeBooksWholeCycleEveryTransitionAndPlacements) {
   EXPECT_EQ(cycle.status().state, "DONE");
   EXPECT_EQ(cycle.status().books_moved, 3);
 
-  // Lower shelf: right covers at 0.37, 0.37 - 0.025 - 0.005 = 0.34, 0.34 - 0.020 - 0.005 = 0.315;
-  // TCP Y = right - BW/2; X = -0.32 (lower_shelf.drop_m) + height + 0.005; Z = 0.01 + 0.03. Base = (0.60 + Z, -0.05 - Y, X).
-  const double ys[3] = {0.37 - 0.0125, 0.34 - 0.010, 0.315 - 0.015};
+  // Lower shelf (coordinator.yaml lower_shelf: first_right_y 0.20, gap 0.005, front_z -0.03, drop 0.32): right covers
+  // at 0.20, 0.20 - 0.025 - 0.005 = 0.17, 0.17 - 0.020 - 0.005 = 0.145; TCP Y = right - BW/2;
+  // X = -0.32 + height + 0.005; Z = -0.03 + 0.03 (insertion) = 0. Base = (0.60 + Z, -0.05 - Y, X).
+  const double ys[3] = {0.20 - 0.0125, 0.17 - 0.010, 0.145 - 0.015};
   const double hs[3] = {0.25, 0.18, 0.22};
   for (int i = 0; i < 3; ++i) {
     const Eigen::Vector3d tcp = w.lower[i].second.translation();
-    EXPECT_NEAR(tcp.x(), 0.64, 0.0015) << "book " << i;
+    EXPECT_NEAR(tcp.x(), 0.60, 0.0015) << "book " << i;
     EXPECT_NEAR(tcp.y(), -0.05 - ys[i], 0.0015) << "book " << i;
     EXPECT_NEAR(tcp.z(), -0.32 + hs[i] + 0.005, 0.0015) << "book " << i;
   }
-  // Holder: support origin (0.301, 0.28, -0.09), base axes; TCP (-0.02, 0.215, h + 0.005) in it.
+  // Holder: support origin (0.301, 0.28, -0.09), base axes; TCP (-0.02, -0.215, h + 0.005) in it (coordinator.yaml
+  // holder.place_tcp_in_support_m: the fingers beyond the back plate's right edge).
   ASSERT_EQ(w.holder_drops.size(), 3u);
   const Eigen::Vector3d h0 = w.holder_drops[0].second.translation();
   EXPECT_NEAR(h0.x(), 0.281, 0.0015);
-  EXPECT_NEAR(h0.y(), 0.495, 0.0015);
+  EXPECT_NEAR(h0.y(), 0.065, 0.0015);
   EXPECT_NEAR(h0.z(), -0.09 + 0.25 + 0.005, 0.0015);
-  // Gripper axes on the holder: x up (base z), y = -base x, z = -base y.
+  // Gripper axes on the holder: x up (base z), y = base x (gripper_y_in_support), z = x cross y = base y.
   const Eigen::Matrix3d r = w.holder_drops[0].second.linear();
   EXPECT_NEAR(r(2, 0), 1.0, 0.02);
-  EXPECT_NEAR(r(0, 1), -1.0, 0.02);
-  EXPECT_NEAR(r(1, 2), -1.0, 0.02);
+  EXPECT_NEAR(r(0, 1), 1.0, 0.02);
+  EXPECT_NEAR(r(1, 2), 1.0, 0.02);
+
+  // The book-corner servo keeps the BwH start's distance to the books: fixed depth = -bwh_start_z_m (0.10 in
+  // coordinator.yaml), so it never pulls the TCP towards the robot (the elbow's limit).
+  int corner_requests = 0;
+  for (const auto& q : w.requests)
+    if (q.kind == CycleRequest::Kind::kServo && q.servo_mode == 1) {  // BOOK_CORNER (SERVO_REQUEST mode)
+      ++corner_requests;
+      EXPECT_NEAR(q.fixed_depth, 0.10, 1e-12);
+    }
+  EXPECT_GE(corner_requests, 3);
 
   // Arm-command duties: heartbeats while trajectories run; twist speeds within the configured limit.
   int heartbeats = 0;

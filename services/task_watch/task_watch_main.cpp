@@ -1,0 +1,115 @@
+// bookgrasp_task: follows the library task on the bus (TASK_STATUS), prints its progress and, when it
+// ends, a summary: books moved, failures with reasons, cycle times. Used by `deploy/bookgrasp demo`.
+#include <csignal>
+#include <cstring>
+#include <iostream>
+
+#include <lcm/lcm-cpp.hpp>
+
+#include "common/lcm_url.h"
+#include "common/time_source.h"
+#include "services/task_watch/task_run_log.h"
+
+namespace {
+
+volatile std::sig_atomic_t g_stop = 0;
+void on_signal(int) {
+  g_stop = 1;
+}
+
+void help() {
+  std::cout << "bookgrasp_task - follow the library task (TASK_STATUS) and summarise it\n\n"
+               "usage: bookgrasp_task [--lcm-url URL] [--channel TASK_STATUS] [--books K] [--timeout S]\n\n"
+               "  --books K     stop following once K books went through the whole cycle (default 0: until\n"
+               "                the coordinator reports DONE or ABORTED)\n"
+               "  --timeout S   give up after S seconds of wall time (default 0: never)\n"
+               "Exit code: 0 DONE or K books moved, 1 ABORTED, 4 timeout or Ctrl-C while running,\n"
+               "5 no TASK_STATUS at all, 2 bad command line, 3 no bus.\n";
+}
+
+struct Listener {
+  bookgrasp::TaskRunLog log;
+  bool any = false;
+  explicit Listener(int books) : log(books) {}
+  void on(const lcm::ReceiveBuffer*, const std::string&, const bookgrasp::task_status_t* m) {
+    any = true;
+    for (const auto& line : log.on_status(*m)) std::cout << line << "\n" << std::flush;
+  }
+};
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::string url_arg, channel = "TASK_STATUS";
+  int books = 0;
+  double timeout_s = 0;
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    auto value = [&]() -> std::string {
+      if (i + 1 >= argc) {
+        std::cerr << "bookgrasp_task: " << a << " needs a value (see --help)\n";
+        std::exit(2);
+      }
+      return argv[++i];
+    };
+    try {
+      if (a == "--help" || a == "-h") {
+        help();
+        return 0;
+      } else if (a == "--lcm-url") {
+        url_arg = value();
+      } else if (a == "--channel") {
+        channel = value();
+      } else if (a == "--books") {
+        books = std::stoi(value());
+      } else if (a == "--timeout") {
+        timeout_s = std::stod(value());
+      } else {
+        std::cerr << "bookgrasp_task: unknown argument '" << a << "' (see --help)\n";
+        return 2;
+      }
+    } catch (const std::exception&) {
+      std::cerr << "bookgrasp_task: " << a << " needs a number (see --help)\n";
+      return 2;
+    }
+  }
+  if (books < 0 || timeout_s < 0) {
+    std::cerr << "bookgrasp_task: --books and --timeout must not be negative\n";
+    return 2;
+  }
+  lcm::LCM lcm(bookgrasp::resolve_lcm_url(url_arg, ""));
+  if (!lcm.good()) {
+    std::cerr << "bookgrasp_task: cannot open the bus: run `deploy/bookgrasp setup`\n";
+    return 3;
+  }
+  struct sigaction sa;
+  std::memset(&sa, 0, sizeof(sa));
+  sa.sa_handler = on_signal;
+  sigaction(SIGINT, &sa, nullptr);
+  sigaction(SIGTERM, &sa, nullptr);
+
+  Listener listener(books);
+  lcm.subscribe(channel, &Listener::on, &listener);
+  // Wall time only bounds how long a person waits; the task's own times are message time.
+  const bookgrasp::WallTimeSource wall;
+  const int64_t until = timeout_s > 0 ? wall.now_utime() + static_cast<int64_t>(timeout_s * 1e6) : INT64_MAX;
+  while (!g_stop && listener.log.end() == bookgrasp::TaskEnd::kRunning && wall.now_utime() < until)
+    lcm.handleTimeout(100);
+
+  std::cout << "\n" << listener.log.summary();
+  if (!listener.any) {
+    std::cout << "no TASK_STATUS on " << channel << ": is the coordinator running?\n";
+    return 5;
+  }
+  switch (listener.log.end()) {
+    case bookgrasp::TaskEnd::kDone:
+    case bookgrasp::TaskEnd::kEnoughBooks:
+      return 0;
+    case bookgrasp::TaskEnd::kAborted:
+      return 1;
+    case bookgrasp::TaskEnd::kRunning:
+      break;
+  }
+  std::cout << (g_stop ? "interrupted" : "timed out") << " while the task was running\n";
+  return 4;
+}
