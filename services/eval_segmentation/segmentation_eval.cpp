@@ -101,6 +101,11 @@ void run_methods(const std::string& suffix, const cv::Mat& disparity, const bws:
   run("god", [&] { return bws::segment(disparity, points, c.god); });
   run("pcl", [&] { return bws::segment(disparity, points, c.pcl); });
   run("jump", [&] { return bws::segment_jump_components(disparity, points, c.jump); });
+  run("rg", [&] {
+    bws::SegmentationResult r;
+    r.labels = segment_region_growing(points, c.region_growing);
+    return r;
+  });
 }
 
 std::string pct(double f) {

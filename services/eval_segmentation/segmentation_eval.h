@@ -3,7 +3,8 @@
 /// The segmentation comparison of issue 4 item 5: on every range scene (range_scene.h) the planar
 /// segmentations of bws_detector -- GoD (services/bws_detector/god_segmentation.h, parameters of
 /// config/services/bws_detector.yaml), the PCL implementation's OrganizedMultiPlaneSegmentation
-/// (config/services/bws_detector_pcl.yaml) and the jump-free connected components baseline -- are run
+/// (config/services/bws_detector_pcl.yaml), the jump-free connected components baseline, and PCL's region
+/// growing on normals ("rg", pcl_region_growing.h) -- are run
 /// on two disparity sources and compared with the ground truth by Hoover's metric at several
 /// tolerances:
 ///   - "true": the renderer's exact depth turned into disparity d = fx B / z, plus zero-mean Gaussian
@@ -22,6 +23,7 @@
 #include "services/bws_detector/baseline_segmentation.h"
 #include "services/bws_detector/bws_pipeline.h"
 #include "services/eval_segmentation/hoover_comparison.h"
+#include "services/eval_segmentation/pcl_region_growing.h"
 #include "services/eval_segmentation/range_scene.h"
 
 namespace bookgrasp::eval_segmentation {
@@ -34,6 +36,8 @@ struct EvalConfig {
   bws::BwsParams pcl;
   /// Jump-components baseline (its defaults: max jump 0.5 disparity px, regions >= 50 px).
   bws::JumpComponentsParams jump;
+  /// Region growing on normals (pcl::RegionGrowing, like Hoover's USF), its defaults (the PCL tutorial's values).
+  RegionGrowingParams region_growing;
   /// Noise of the "true" source, disparity pixels (standard deviation).
   double true_noise_px = 0.1;
   /// Rounding step of the "true" source, disparity pixels (StereoBM: 1/16).
@@ -60,7 +64,7 @@ cv::Mat true_disparity(const cv::Mat& depth, double fx, double baseline_m, doubl
 
 /// One method's segmentation of one source.
 struct MethodRun {
-  /// "god", "pcl", "jump" (true source) or "god_stereo", ... (stereo source).
+  /// "god", "pcl", "jump", "rg" (true source) or "god_stereo", ... (stereo source).
   std::string name;
   /// CV_32S labels, 0 = no region.
   cv::Mat labels;

@@ -100,7 +100,7 @@ TEST(SegmentationEval, ToolWritesConsistentMetrics) {
   EXPECT_EQ(m["scenes"].as<int>(), 2);
   EXPECT_GT(m["gt_regions"].as<int>(), 20);
   EXPECT_GE(m["curved_gt_regions"].as<int>(), 1);
-  const char* methods[] = {"god", "pcl", "jump", "god_stereo", "pcl_stereo", "jump_stereo"};
+  const char* methods[] = {"god", "pcl", "jump", "rg", "god_stereo", "pcl_stereo", "jump_stereo", "rg_stereo"};
   const char* tols[] = {"T0.5", "T0.6", "T0.7", "T0.8", "T0.9"};
   for (const char* name : methods) {
     ASSERT_TRUE(m["methods"][name]) << name;
