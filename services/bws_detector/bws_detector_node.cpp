@@ -168,7 +168,12 @@ void BwsDetectorNode::on_stereo(const stereo_frame_t& frame) {
   image_t debug;
   const std::string why = process(frame, &out, &debug);
   if (!why.empty()) {
-    reject(s_.stereo_channel, why);
+    // Before the first cart marker the frame is not bad input, the system is starting (or this
+    // detector just restarted): skipped and said in last_error, not counted as a rejection.
+    if (!marker_in_base_)
+      report_error("waiting: " + why);
+    else
+      reject(s_.stereo_channel, why);
     return;
   }
   publish(s_.corner_channel, out);

@@ -36,10 +36,11 @@ double TaskRunLog::elapsed_s() const {
 
 std::vector<std::string> TaskRunLog::on_status(const task_status_t& s) {
   std::vector<std::string> lines;
-  if (last_utime_ >= 0 && s.utime < last_utime_) {
-    if (!warned_old_) lines.push_back("ignoring a TASK_STATUS older than the last one (duplicate or late packet)");
+  if (last_utime_ >= 0 && s.utime < last_utime_ && !warned_old_) {
+    // The coordinator's clock is the latest event it saw; events of different sources can step it
+    // back a little. Followed anyway (a state change is never dropped); times stay monotonic.
+    lines.push_back("note: a TASK_STATUS older than the previous one (message time stepped back)");
     warned_old_ = true;
-    return lines;
   }
   if (first_utime_ < 0) {
     first_utime_ = s.utime;
@@ -47,15 +48,15 @@ std::vector<std::string> TaskRunLog::on_status(const task_status_t& s) {
     books_moved_ = s.books_moved;  // a resumed task starts with books already moved
     failures_count_ = s.failures;
   }
-  last_utime_ = s.utime;
+  last_utime_ = std::max(last_utime_, s.utime);
   const std::string t = "[" + seconds(elapsed_s()) + "] ";
   while (books_moved_ < s.books_moved) {
     MovedBook b;
     b.index = books_moved_;
-    b.cycle_s = static_cast<double>(s.utime - book_start_utime_) * 1e-6;
+    b.cycle_s = static_cast<double>(last_utime_ - book_start_utime_) * 1e-6;
     moved_.push_back(b);
     ++books_moved_;
-    book_start_utime_ = s.utime;
+    book_start_utime_ = last_utime_;
     lines.push_back(t + "book " + std::to_string(b.index + 1) + " moved to the lower shelf (cycle " +
                     seconds(b.cycle_s) + ")");
   }

@@ -36,8 +36,8 @@ class TaskRunLog {
   explicit TaskRunLog(int stop_after_books = 0) : stop_after_books_(stop_after_books) {}
 
   /// Feeds one TASK_STATUS. Returns the progress lines to show (state changes, books moved,
-  /// failures); empty when nothing changed. Statuses older than the last one are ignored
-  /// (a duplicate or a late packet) and say so once.
+  /// failures); empty when nothing changed. A status older than the previous one is still
+  /// followed (noted once); elapsed and cycle times use the latest message time seen.
   std::vector<std::string> on_status(const task_status_t& s);
 
   /// kRunning until DONE, ABORTED or enough books moved.
