@@ -86,7 +86,7 @@ TEST(SegmentationEval, GodDetectsTheRightmostFrontOnSeed3) {
   EXPECT_EQ(e.runs.front().hoover.at(0).gt_class_of(front), HooverClass::kCorrect);
 }
 
-// The tool on 2 scenes: metrics.json has methods.<name>.T<tol>.{correct,over,under,missed,noise}, every
+// The tool on 1 scene: metrics.json has methods.<name>.T<tol>.{correct,over,under,missed,noise}, every
 // fraction in [0, 1], the GT-side fractions add up to 1 (rounding: 4 decimals), correct detections do
 // not increase with T; report.md and the scene picture exist.
 TEST(SegmentationEval, ToolWritesConsistentMetrics) {
@@ -94,11 +94,11 @@ TEST(SegmentationEval, ToolWritesConsistentMetrics) {
   std::filesystem::remove_all(out);
   const std::string tool =
       std::string(BOOKGRASP_BINARY_DIR) + "/services/eval_segmentation/bookgrasp_eval_segmentation";
-  const std::string cmd = tool + " --out " + out + " --scenes 2 --seed 4 --pictures 1 2>/dev/null >/dev/null";
+  const std::string cmd = tool + " --out " + out + " --scenes 1 --seed 4 --pictures 1 2>/dev/null >/dev/null";
   ASSERT_EQ(std::system(cmd.c_str()), 0) << cmd;
   const YAML::Node m = YAML::LoadFile(out + "/metrics.json");
-  EXPECT_EQ(m["scenes"].as<int>(), 2);
-  EXPECT_GT(m["gt_regions"].as<int>(), 20);
+  EXPECT_EQ(m["scenes"].as<int>(), 1);
+  EXPECT_GT(m["gt_regions"].as<int>(), 10);
   EXPECT_GE(m["curved_gt_regions"].as<int>(), 1);
   const char* methods[] = {"god", "pcl", "jump", "rg", "god_stereo", "pcl_stereo", "jump_stereo", "rg_stereo"};
   const char* tols[] = {"T0.5", "T0.6", "T0.7", "T0.8", "T0.9"};
@@ -139,7 +139,6 @@ TEST(SegmentationEval, ToolWritesConsistentMetrics) {
   EXPECT_NE(text.str().find("| 0.8 |"), std::string::npos);
   EXPECT_NE(text.str().find("73"), std::string::npos);
   EXPECT_TRUE(std::filesystem::exists(out + "/scene_4.png"));
-  EXPECT_FALSE(std::filesystem::exists(out + "/scene_5.png"));
   // Bad arguments: a clear refusal, not a crash.
   EXPECT_NE(std::system((tool + " --scenes 0 --out " + out + " 2>/dev/null").c_str()), 0);
   EXPECT_NE(std::system((tool + " --scenes 1 2>/dev/null").c_str()), 0);
