@@ -125,10 +125,6 @@ StripeDetection detect_stripe(const cv::Mat& image, const StripeDetectionParams&
                     std::to_string(p.min_length_px) + ")";
       continue;
     }
-    if (p.reject_touching_bottom && by + bh >= usable_rows - 1) {
-      last_reject = "dark horizontal region touches the image bottom (a shadow on the shelf or the fingers)";
-      continue;
-    }
     std::vector<int> count(static_cast<size_t>(bw), 0);
     std::vector<double> ysum(static_cast<size_t>(bw), 0.0);
     for (int y = by; y < by + bh; ++y) {
@@ -173,6 +169,16 @@ StripeDetection detect_stripe(const cv::Mat& image, const StripeDetectionParams&
     s.x_max = x_max;
     s.length = static_cast<int>(centres.size());
     if (s.length < p.min_length_px) continue;
+    if (p.reject_touching_bottom) {
+      // The band itself (centre line +- half its thickness) reaching the bottom: a shadow on the shelf or
+      // beside the fingers. (A stripe joined to a dark cover that reaches the bottom is kept: the cover's
+      // columns are not band columns.)
+      const double low = std::max(s.slope * x_min, s.slope * x_max) + s.intercept + 0.5 * median;
+      if (low >= usable_rows - 2) {
+        last_reject = "dark horizontal band touches the image bottom (a shadow on the shelf or the fingers)";
+        continue;
+      }
+    }
     if (s.length < p.min_band_fill * bw) {
       last_reject = "dark region is not a band: " + std::to_string(s.length) + " of " + std::to_string(bw) +
                     " columns have the band's thickness (min_band_fill)";

@@ -2,7 +2,7 @@
 /// bookgrasp_eval_hand: the hand-camera evaluation (issue 5, paper Figures 13 and 14).
 ///
 ///   bookgrasp_eval_hand --scenes N --seed S [--scene FILE] [--config-dir DIR] [--no-markers]
-///                       [--debug-images] --out DIR
+///                       [--debug-images] [--debug-every K] --out DIR
 ///
 /// For scenes S..S+N-1 of FILE (default services/eval_hand/scenes/hand_eval.yaml) the visual servo is closed
 /// in simulation (hand_servo_harness.h): the stripe servo from station A (PS vs the true stripe end) and the
@@ -27,10 +27,12 @@ namespace {
 int usage(const std::string& why) {
   if (!why.empty()) std::cerr << "bookgrasp_eval_hand: " << why << "\n";
   std::cerr << "usage: bookgrasp_eval_hand --scenes N --seed S [--scene FILE] [--config-dir DIR] [--no-markers]\n"
-               "                           [--debug-images] --out DIR\n"
+               "                           [--debug-images] [--debug-every K] --out DIR\n"
                "  closes the stripe and corner servos in simulation on scenes S..S+N-1 (default scene\n"
                "  services/eval_hand/scenes/hand_eval.yaml), errors against the simulation's ground truth;\n"
-               "  writes DIR/metrics.json, DIR/report.md and the PNG plots (Figures 13 and 14)\n";
+               "  writes DIR/metrics.json, DIR/report.md and the PNG plots (Figures 13 and 14);\n"
+               "  --debug-images: first/last hand image of each task in DIR/images (overlay and raw),\n"
+               "  --debug-every K: also every K-th frame\n";
   return why.empty() ? 0 : 2;
 }
 
@@ -43,6 +45,7 @@ std::string in_source(const std::string& p) {
 int main(int argc, char** argv) {
   long long scenes = -1, seed = -1;
   bool markers = true, debug_images = false;
+  int debug_every = 0;
   std::string scene_file = "services/eval_hand/scenes/hand_eval.yaml", config_dir = "config/services", out_dir;
   std::string command = "bookgrasp_eval_hand";
   for (int i = 1; i < argc; ++i) command += std::string(" ") + argv[i];
@@ -57,7 +60,8 @@ int main(int argc, char** argv) {
       debug_images = true;
       continue;
     }
-    if (a != "--scenes" && a != "--seed" && a != "--scene" && a != "--config-dir" && a != "--out")
+    if (a != "--scenes" && a != "--seed" && a != "--scene" && a != "--config-dir" && a != "--out" &&
+        a != "--debug-every")
       return usage("unknown option " + a);
     if (i + 1 >= argc) return usage(a + " needs a value");
     const std::string v = argv[++i];
@@ -72,6 +76,10 @@ int main(int argc, char** argv) {
       if (!integer(&seed)) return usage("--seed must be a non-negative integer, not '" + v + "'");
     } else if (a == "--scene") {
       scene_file = v;
+    } else if (a == "--debug-every") {
+      long long n = 0;
+      if (!integer(&n) || n < 1) return usage("--debug-every must be a positive integer, not '" + v + "'");
+      debug_every = static_cast<int>(n);
     } else if (a == "--config-dir") {
       config_dir = v;
     } else {
@@ -94,7 +102,8 @@ int main(int argc, char** argv) {
   } catch (const std::exception& e) {
     return usage("cannot create --out " + out_dir + ": " + e.what());
   }
-  if (debug_images) settings.debug_image_dir = (std::filesystem::path(out_dir) / "images").string();
+  if (debug_images || debug_every > 0) settings.debug_image_dir = (std::filesystem::path(out_dir) / "images").string();
+  settings.debug_every_frames = debug_every;
 
   const bookgrasp::HandTolerances tol;
   bookgrasp::HandEvalMetrics m;

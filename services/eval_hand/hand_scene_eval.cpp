@@ -106,6 +106,7 @@ HandSceneOutcome evaluate_hand_scene(uint64_t seed, const HandSceneSettings& set
     opt.config_dir = settings.config_dir;
     opt.camera_rate_hz = settings.camera_rate_hz;
     opt.debug_image_dir = settings.debug_image_dir;
+    opt.debug_every_frames = settings.debug_every_frames;
 
     // Stripe servo from station A: PS against the true stripe end.
     {

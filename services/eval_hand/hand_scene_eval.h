@@ -23,10 +23,11 @@ struct HandSceneSettings {
   double stripe_timeout_s = 20.0;                                  ///< SERVO_REQUEST.timeout_s of the stripe task
   double corner_standoff_m = 0.22;                                 ///< corner task: TCP to the book front
   double corner_max_offset_m = 0.05;  ///< corner start: P1 + an offset drawn (seeded) in a disc of this radius
-  double corner_timeout_s = 15.0;
-  double camera_rate_hz = 15.0;  ///< hand camera frames per second of simulation time
-  bool run_markers = true;       ///< time the marker detector on the stereo left image
-  std::string debug_image_dir;   ///< first/last hand images of each task (optional)
+  double corner_timeout_s = 15.0;     ///< SERVO_REQUEST.timeout_s of the corner task
+  double camera_rate_hz = 15.0;       ///< hand camera frames per second of simulation time
+  bool run_markers = true;            ///< time the marker detector on the stereo left image
+  std::string debug_image_dir;        ///< first/last hand images of each task (optional)
+  int debug_every_frames = 0;         ///< with debug_image_dir: also every this many frames
 };
 
 /// Runs scene `seed`. Never throws: a set-up error goes into HandSceneOutcome::error.

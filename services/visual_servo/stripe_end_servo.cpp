@@ -106,6 +106,9 @@ StripeServoStep StripeEndServo::step(const StripeObservation& obs, double stando
   GripperTwist t = GripperTwist::Zero();
   t(0) = p_.gain * p.x();
   t(1) = p_.gain * p.y();
+  const double tol[2] = {p_.converged_x_m, p_.converged_y_m};
+  for (int k = 0; k < 2; ++k)
+    if (std::abs(p(k)) > tol[k] && std::abs(t(k)) < p_.min_track_speed) t(k) = std::copysign(p_.min_track_speed, p(k));
   out.twist = saturate_twist(t, p_.max_linear_speed, 1.0);
   const bool ok = std::abs(p.x()) <= p_.converged_x_m && std::abs(p.y()) <= p_.converged_y_m;
   in_tolerance_ = ok ? in_tolerance_ + 1 : 0;

@@ -47,6 +47,8 @@ struct StripeEndServoParams {
   double converged_y_m = 0.0015;       ///< ... and |error right| below this ...
   int converged_frames = 3;            ///< ... on this many consecutive measurements
   double max_search_distance_m = 1.0;  ///< give up the search after this much travel
+  double min_track_speed = 0.0;        ///< TRACK: an axis outside its tolerance moves at least this fast (m/s), so
+                                       ///< the arm does not stall just outside the tolerance (0 = pure P law)
   int track_lost_frames = 0;           ///< TRACK: the end missing on this many consecutive observations -> back to
                                        ///< SEARCH (an end seen through a gap between books disappears as the
                                        ///< camera moves); 0 = never (the session reports FEATURE_LOST)

@@ -170,5 +170,26 @@ TEST(StripeEndServo, AnEndThatVanishesWhileTrackingSendsTheSearchOn) {
   }
 }
 
+TEST(StripeEndServo, MinimumTrackSpeedOutsideTheToleranceOnly) {
+  const HandEyeGeometry g = test::project_geometry();
+  StripeEndServoParams p = params();
+  p.require_occlusion = false;
+  p.min_track_speed = 0.004;
+  StripeEndServo servo(g, p);
+  const Eigen::Vector2d target = g.target_pixel(0.5);
+  StripeObservation o;
+  o.found = o.end_found = true;
+  o.line_start_px = o.end_px = target + Eigen::Vector2d(2.0, 0.0);  // ~2.3 mm right at 0.55 m: outside 1.5 mm
+  o.line_end_px = {639, target.y()};
+  StripeServoStep s = servo.step(o, 0.5, 0.0);
+  ASSERT_EQ(s.phase, StripePhase::kTrack);
+  ASSERT_GT(std::abs(s.error_m.y()), p.converged_y_m);
+  EXPECT_NEAR(s.twist(1), 0.004, 1e-12);                            // the P law alone gives 1.2 * 2.3 mm/s
+  EXPECT_NEAR(s.twist(0), 0.0, 1e-6);                               // X within its tolerance: no minimum
+  o.line_start_px = o.end_px = target + Eigen::Vector2d(0.5, 0.0);  // inside the tolerance: P law
+  s = servo.step(o, 0.5, 0.0);
+  EXPECT_NEAR(s.twist(1), p.gain * s.error_m.y(), 1e-12);
+}
+
 }  // namespace
 }  // namespace bookgrasp
