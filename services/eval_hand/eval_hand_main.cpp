@@ -120,8 +120,16 @@ int main(int argc, char** argv) {
     if (o.corner.converged) std::cerr << " (" << o.corner.error_x_m * 1e3 << ", " << o.corner.error_y_m * 1e3 << ") mm";
     if (!o.error.empty()) std::cerr << ", ERROR " << o.error;
     std::cerr << ", " << o.wall_s << " s; failed scenes so far " << m.failed_scenes << std::endl;
-    // metrics.json after every scene, so a long run can be stopped and still be read.
+    // metrics.json after every scene and the report every 10, so a long run can be stopped and still be read.
     std::ofstream(metrics_path) << bookgrasp::hand_metrics_json(m, command, outcomes);
+    if ((k + 1) % 10 == 0 && k + 1 < scenes) {
+      try {
+        bookgrasp::write_hand_report(out_dir, m, outcomes, tol,
+                                     command + "  (partial: " + std::to_string(k + 1) + " scenes)");
+      } catch (const std::exception& e) {
+        std::cerr << "bookgrasp_eval_hand: " << e.what() << "\n";
+      }
+    }
   }
   try {
     bookgrasp::write_hand_report(out_dir, m, outcomes, tol, command);
