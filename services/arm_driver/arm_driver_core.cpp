@@ -9,10 +9,14 @@ namespace bookgrasp {
 
 std::string driver_state_name(DriverState s) {
   switch (s) {
-    case DriverState::kIdle: return "IDLE";
-    case DriverState::kExecuting: return "EXECUTING";
-    case DriverState::kStopped: return "STOPPED";
-    case DriverState::kFault: return "FAULT";
+    case DriverState::kIdle:
+      return "IDLE";
+    case DriverState::kExecuting:
+      return "EXECUTING";
+    case DriverState::kStopped:
+      return "STOPPED";
+    case DriverState::kFault:
+      return "FAULT";
   }
   return "?";
 }
@@ -83,9 +87,13 @@ std::string ArmDriverCore::command_cartesian_velocity(const Eigen::Matrix<double
   return "";
 }
 
-void ArmDriverCore::command_stop(const std::string& reason) { stop(reason); }
+void ArmDriverCore::command_stop(const std::string& reason) {
+  stop(reason);
+}
 
-void ArmDriverCore::heartbeat() { last_heard_ = now_; }
+void ArmDriverCore::heartbeat() {
+  last_heard_ = now_;
+}
 
 std::string ArmDriverCore::command_gripper(double width, double force) {
   if (!std::isfinite(width) || !std::isfinite(force)) return "gripper width/force not finite";
@@ -140,6 +148,14 @@ DriverSetpoint ArmDriverCore::update(int64_t now_utime) {
     const double l2 = params_.cartesian_damping * params_.cartesian_damping;
     const Eigen::Matrix<double, 6, 6> jjt = jac * jac.transpose() + l2 * Eigen::Matrix<double, 6, 6>::Identity();
     Eigen::VectorXd qd = jac.transpose() * jjt.ldlt().solve(tw);
+    if (params_.nullspace_gain > 0 && params_.preferred_posture.size() == qd.size()) {
+      // Null-space projector of the damped pseudo-inverse J+ = J^T (J J^T + lambda^2 I)^-1: N = I - J+ J.
+      const Eigen::MatrixXd jpinv = jac.transpose() * jjt.ldlt().solve(Eigen::Matrix<double, 6, 6>::Identity());
+      const Eigen::MatrixXd n = Eigen::MatrixXd::Identity(qd.size(), qd.size()) - jpinv * jac;
+      Eigen::VectorXd qn = n * (params_.nullspace_gain * (params_.preferred_posture - q_cmd_));
+      if (qn.norm() > params_.nullspace_max_speed) qn *= params_.nullspace_max_speed / qn.norm();
+      qd += qn;
+    }
     // Scale down uniformly if a joint would exceed its velocity limit.
     double scale = 1.0;
     for (int j = 0; j < qd.size(); ++j)

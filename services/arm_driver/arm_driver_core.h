@@ -22,19 +22,25 @@ enum class DriverState { kIdle = 0, kExecuting = 1, kStopped = 2, kFault = 3 };
 
 /// Timing and gripper parameters of the driver.
 struct DriverParams {
-  double heartbeat_timeout_s = 0.5;   ///< stop when no command/heartbeat for this long (message time)
-  double cartesian_damping = 0.01;    ///< damped least squares lambda for Cartesian velocity
-  double gripper_max_width = 0.0602;  ///< m
-  double gripper_min_width = 0.0;     ///< m
-  double gripper_default_force = 100; ///< N, used when a command gives 0
+  double heartbeat_timeout_s = 0.5;  ///< stop when no command/heartbeat for this long (message time)
+  double cartesian_damping = 0.01;   ///< damped least squares lambda for Cartesian velocity
+  /// Null-space pull towards `preferred_posture` during Cartesian velocity (1/s; 0 = none): the redundant
+  /// joint motion that leaves the TCP twist unchanged is used to keep the arm near that posture (the swivel
+  /// the planner chose, away from the wrist's limits) instead of drifting while a servo runs.
+  double nullspace_gain = 0.0;
+  double nullspace_max_speed = 0.3;    ///< rad/s, largest null-space joint speed (norm)
+  Eigen::VectorXd preferred_posture;   ///< rad, one value per arm joint (empty = no null-space term)
+  double gripper_max_width = 0.0602;   ///< m
+  double gripper_min_width = 0.0;      ///< m
+  double gripper_default_force = 100;  ///< N, used when a command gives 0
 };
 
 /// What to send to the arm now.
 struct DriverSetpoint {
-  Eigen::VectorXd q;        ///< joint positions (rad)
-  Eigen::VectorXd qd;       ///< joint velocities (rad/s)
-  double gripper_width = 0; ///< m
-  double gripper_force = 0; ///< N
+  Eigen::VectorXd q;         ///< joint positions (rad)
+  Eigen::VectorXd qd;        ///< joint velocities (rad/s)
+  double gripper_width = 0;  ///< m
+  double gripper_force = 0;  ///< N
 };
 
 /// The arm driver's state machine.

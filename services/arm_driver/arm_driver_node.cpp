@@ -10,9 +10,13 @@
 namespace bookgrasp {
 namespace {
 
-std::string resolve(const std::string& path) { return path.empty() || path[0] == '/' ? path : std::string(kSourceDir) + "/" + path; }
+std::string resolve(const std::string& path) {
+  return path.empty() || path[0] == '/' ? path : std::string(kSourceDir) + "/" + path;
+}
 
-Eigen::VectorXd vec(const std::vector<double>& v) { return Eigen::Map<const Eigen::VectorXd>(v.data(), v.size()); }
+Eigen::VectorXd vec(const std::vector<double>& v) {
+  return Eigen::Map<const Eigen::VectorXd>(v.data(), v.size());
+}
 
 JointTrajectory from_message(const joint_trajectory_t& m) {
   JointTrajectory t;
@@ -38,9 +42,8 @@ JointTrajectory from_message(const joint_trajectory_t& m) {
 
 ArmDriverCore make_arm_driver_core(const Config& root) {
   const Config robot = root.child("robot");
-  ArmKinematics kin = ArmKinematics::from_urdf_file(resolve(robot.get<std::string>("urdf")),
-                                                    robot.get<std::string>("base_link"),
-                                                    robot.get<std::string>("tip_link"));
+  ArmKinematics kin = ArmKinematics::from_urdf_file(
+      resolve(robot.get<std::string>("urdf")), robot.get<std::string>("base_link"), robot.get<std::string>("tip_link"));
   const int n = kin.num_joints();
   const Config lim = root.child("limits");
   ArmLimits limits;
@@ -62,6 +65,14 @@ ArmDriverCore make_arm_driver_core(const Config& root) {
   DriverParams p;
   p.heartbeat_timeout_s = root.get_double("heartbeat_timeout_s", 0.01, 10.0);
   p.cartesian_damping = root.get_double("cartesian_damping", 0.0, 1.0);
+  p.nullspace_gain = root.get_double("cartesian_nullspace.gain", 0.0, 10.0);
+  p.nullspace_max_speed = root.get_double("cartesian_nullspace.max_speed", 0.0, 2.0);
+  const std::vector<double> pp = root.get_vector("cartesian_nullspace.preferred_posture", 7);
+  p.preferred_posture = Eigen::Map<const Eigen::VectorXd>(pp.data(), 7);
+  for (int j = 0; j < 7; ++j)
+    if (pp[j] < limits.lower[j] || pp[j] > limits.upper[j])
+      throw ConfigError(root.source() + ": key 'cartesian_nullspace.preferred_posture': joint " +
+                        std::to_string(j + 1) + " outside its limits");
   const Config g = root.child("gripper");
   p.gripper_min_width = g.get_double("min_width", 0.0, 0.1);
   p.gripper_max_width = g.get_double("max_width", 0.0, 0.1);
@@ -131,16 +142,23 @@ void ArmDriverNode::on_sim_state(const sim_state_t& msg) {
 void ArmDriverNode::on_arm_command(const arm_command_t& msg) {
   std::string why;
   switch (msg.mode) {
-    case arm_command_t::HEARTBEAT: core_.heartbeat(); return;
-    case arm_command_t::STOP: core_.command_stop("stop commanded (command " + std::to_string(msg.command_id) + ")"); break;
-    case arm_command_t::TRAJECTORY: why = core_.command_trajectory(from_message(msg.trajectory), msg.command_id); break;
+    case arm_command_t::HEARTBEAT:
+      core_.heartbeat();
+      return;
+    case arm_command_t::STOP:
+      core_.command_stop("stop commanded (command " + std::to_string(msg.command_id) + ")");
+      break;
+    case arm_command_t::TRAJECTORY:
+      why = core_.command_trajectory(from_message(msg.trajectory), msg.command_id);
+      break;
     case arm_command_t::CARTESIAN_VELOCITY: {
       Eigen::Matrix<double, 6, 1> tw;
       for (int i = 0; i < 6; ++i) tw[i] = msg.twist[i];
       why = core_.command_cartesian_velocity(tw, msg.twist_frame, msg.command_id);
       break;
     }
-    default: why = "unknown arm command mode " + std::to_string(static_cast<int>(msg.mode));
+    default:
+      why = "unknown arm command mode " + std::to_string(static_cast<int>(msg.mode));
   }
   if (!why.empty()) reject(ch_.arm_command, "command " + std::to_string(msg.command_id) + " refused: " + why);
   publish_state(last_measure_utime_);
@@ -149,12 +167,20 @@ void ArmDriverNode::on_arm_command(const arm_command_t& msg) {
 void ArmDriverNode::on_gripper_command(const gripper_command_t& msg) {
   std::string why;
   switch (msg.mode) {
-    case gripper_command_t::MOVE: why = core_.command_gripper(msg.width_m, msg.force_n); break;
-    case gripper_command_t::GRASP: why = core_.command_gripper(0.0, msg.force_n); break;
-    case gripper_command_t::STOP: why = core_.command_gripper(gripper_width_, msg.force_n); break;
-    default: why = "unknown gripper command mode " + std::to_string(static_cast<int>(msg.mode));
+    case gripper_command_t::MOVE:
+      why = core_.command_gripper(msg.width_m, msg.force_n);
+      break;
+    case gripper_command_t::GRASP:
+      why = core_.command_gripper(0.0, msg.force_n);
+      break;
+    case gripper_command_t::STOP:
+      why = core_.command_gripper(gripper_width_, msg.force_n);
+      break;
+    default:
+      why = "unknown gripper command mode " + std::to_string(static_cast<int>(msg.mode));
   }
-  if (!why.empty()) throw std::invalid_argument("gripper command " + std::to_string(msg.command_id) + " refused: " + why);
+  if (!why.empty())
+    throw std::invalid_argument("gripper command " + std::to_string(msg.command_id) + " refused: " + why);
 }
 
 void ArmDriverNode::publish_state(int64_t utime) {

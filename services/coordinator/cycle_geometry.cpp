@@ -12,7 +12,8 @@ Eigen::Vector3d vec3(const Config& c, const std::string& key, double limit = 5.0
   const std::vector<double> v = c.get_vector(key, 3);
   const Eigen::Vector3d e(v[0], v[1], v[2]);
   if (!e.allFinite() || e.norm() > limit)
-    throw ConfigError(c.source() + ": " + c.path_of(key) + " must be finite and within " + std::to_string(limit) + " m");
+    throw ConfigError(c.source() + ": " + c.path_of(key) + " must be finite and within " + std::to_string(limit) +
+                      " m");
   return e;
 }
 
@@ -34,8 +35,8 @@ CycleGeometry CycleGeometry::from_config(const Config& c) {
   g.grasp_offset_y = c.get_double("grasp.offset_y_m", -0.1, 0.1);
   g.insertion_depth = c.get_double("grasp.insertion_depth_m", 0.0, 0.2);
   g.pre_grasp_distance = c.get_double("grasp.pre_grasp_distance_m", 0.01, 0.5);
-  g.extract_lift = c.get_double("grasp.extract_lift_m", 0.0, 0.1);
-  g.extract_retreat = c.get_double("grasp.extract_retreat_m", 0.05, 1.0);
+  g.extract_lift = c.get_double("grasp.extract_lift_m", 0.0, 0.5);
+  g.extract_retreat = c.get_double("grasp.extract_retreat_m", 0.0, 1.0);
   g.holder_support_in_marker = vec3(c, "holder.support_origin_in_marker_m");
   g.holder_place_tcp = vec3(c, "holder.place_tcp_in_support_m");
   const Eigen::Vector3d x = vec3(c, "holder.gripper_x_in_support"), y = vec3(c, "holder.gripper_y_in_support");
@@ -70,9 +71,9 @@ Eigen::Isometry3d cart_grasp_frame(const Eigen::Isometry3d& m, const CycleGeomet
 
 Eigen::Isometry3d holder_support_frame(const Eigen::Isometry3d& m, const CycleGeometry& g) {
   Eigen::Isometry3d s = Eigen::Isometry3d::Identity();
-  s.linear().col(0) = m.linear().col(2);    // into the back plate
-  s.linear().col(1) = -m.linear().col(0);   // left along the plate (tag x is right)
-  s.linear().col(2) = -m.linear().col(1);   // up along the plate (tag y is down)
+  s.linear().col(0) = m.linear().col(2);   // into the back plate
+  s.linear().col(1) = -m.linear().col(0);  // left along the plate (tag x is right)
+  s.linear().col(2) = -m.linear().col(1);  // up along the plate (tag y is down)
   s.translation() = m * g.holder_support_in_marker;
   return s;
 }

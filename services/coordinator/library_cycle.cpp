@@ -25,13 +25,20 @@ std::string mm(double m) {
 
 std::string servo_state_name(int s) {
   switch (s) {
-    case 0: return "IDLE";
-    case 1: return "RUNNING";
-    case 2: return "CONVERGED";
-    case 3: return "FEATURE_LOST";
-    case 4: return "TIMEOUT";
-    case 5: return "FAILED";
-    case 6: return "CANCELLED";
+    case 0:
+      return "IDLE";
+    case 1:
+      return "RUNNING";
+    case 2:
+      return "CONVERGED";
+    case 3:
+      return "FEATURE_LOST";
+    case 4:
+      return "TIMEOUT";
+    case 5:
+      return "FAILED";
+    case 6:
+      return "CANCELLED";
   }
   return "state " + std::to_string(s);
 }
@@ -50,39 +57,72 @@ bool in(CycleState s, std::initializer_list<CycleState> set) {
 
 std::string cycle_state_name(CycleState s) {
   switch (s) {
-    case CycleState::kStart: return "START";
-    case CycleState::kWaitMarkers: return "WAIT_MARKERS";
-    case CycleState::kBackOut: return "BACK_OUT";
-    case CycleState::kPark: return "PARK";
-    case CycleState::kWaitP1Check: return "WAIT_P1_CHECK";
-    case CycleState::kMoveToStripeStart: return "MOVE_TO_STRIPE_START";
-    case CycleState::kServoStripe: return "SERVO_STRIPE";
-    case CycleState::kWaitPsCheck: return "WAIT_PS_CHECK";
-    case CycleState::kMoveToBwhStart: return "MOVE_TO_BWH_START";
-    case CycleState::kServoBook: return "SERVO_BOOK";
-    case CycleState::kWaitDecision: return "WAIT_DECISION";
-    case CycleState::kMoveToPreGrasp: return "MOVE_TO_PRE_GRASP";
-    case CycleState::kOpenForGrasp: return "OPEN_FOR_GRASP";
-    case CycleState::kInsert: return "INSERT";
-    case CycleState::kCloseGripper: return "CLOSE_GRIPPER";
-    case CycleState::kExtract: return "EXTRACT";
-    case CycleState::kMoveToHolder: return "MOVE_TO_HOLDER";
-    case CycleState::kPlaceOnHolder: return "PLACE_ON_HOLDER";
-    case CycleState::kReleaseOnHolder: return "RELEASE_ON_HOLDER";
-    case CycleState::kRetreatFromHolder: return "RETREAT_FROM_HOLDER";
-    case CycleState::kParkForUser: return "PARK_FOR_USER";
-    case CycleState::kWaitUser: return "WAIT_USER";
-    case CycleState::kMoveToHolderPreGrasp: return "MOVE_TO_HOLDER_PRE_GRASP";
-    case CycleState::kOpenForHolderGrasp: return "OPEN_FOR_HOLDER_GRASP";
-    case CycleState::kApproachHolder: return "APPROACH_HOLDER";
-    case CycleState::kGraspFromHolder: return "GRASP_FROM_HOLDER";
-    case CycleState::kLiftFromHolder: return "LIFT_FROM_HOLDER";
-    case CycleState::kMoveToLowerShelf: return "MOVE_TO_LOWER_SHELF";
-    case CycleState::kPlaceOnLowerShelf: return "PLACE_ON_LOWER_SHELF";
-    case CycleState::kReleaseOnLowerShelf: return "RELEASE_ON_LOWER_SHELF";
-    case CycleState::kRetreatFromLowerShelf: return "RETREAT_FROM_LOWER_SHELF";
-    case CycleState::kDone: return "DONE";
-    case CycleState::kAborted: return "ABORTED";
+    case CycleState::kStart:
+      return "START";
+    case CycleState::kWaitMarkers:
+      return "WAIT_MARKERS";
+    case CycleState::kBackOut:
+      return "BACK_OUT";
+    case CycleState::kPark:
+      return "PARK";
+    case CycleState::kWaitP1Check:
+      return "WAIT_P1_CHECK";
+    case CycleState::kMoveToStripeStart:
+      return "MOVE_TO_STRIPE_START";
+    case CycleState::kServoStripe:
+      return "SERVO_STRIPE";
+    case CycleState::kWaitPsCheck:
+      return "WAIT_PS_CHECK";
+    case CycleState::kMoveToBwhStart:
+      return "MOVE_TO_BWH_START";
+    case CycleState::kServoBook:
+      return "SERVO_BOOK";
+    case CycleState::kWaitDecision:
+      return "WAIT_DECISION";
+    case CycleState::kMoveToPreGrasp:
+      return "MOVE_TO_PRE_GRASP";
+    case CycleState::kOpenForGrasp:
+      return "OPEN_FOR_GRASP";
+    case CycleState::kInsert:
+      return "INSERT";
+    case CycleState::kCloseGripper:
+      return "CLOSE_GRIPPER";
+    case CycleState::kExtract:
+      return "EXTRACT";
+    case CycleState::kMoveToHolder:
+      return "MOVE_TO_HOLDER";
+    case CycleState::kPlaceOnHolder:
+      return "PLACE_ON_HOLDER";
+    case CycleState::kReleaseOnHolder:
+      return "RELEASE_ON_HOLDER";
+    case CycleState::kRetreatFromHolder:
+      return "RETREAT_FROM_HOLDER";
+    case CycleState::kParkForUser:
+      return "PARK_FOR_USER";
+    case CycleState::kWaitUser:
+      return "WAIT_USER";
+    case CycleState::kMoveToHolderPreGrasp:
+      return "MOVE_TO_HOLDER_PRE_GRASP";
+    case CycleState::kOpenForHolderGrasp:
+      return "OPEN_FOR_HOLDER_GRASP";
+    case CycleState::kApproachHolder:
+      return "APPROACH_HOLDER";
+    case CycleState::kGraspFromHolder:
+      return "GRASP_FROM_HOLDER";
+    case CycleState::kLiftFromHolder:
+      return "LIFT_FROM_HOLDER";
+    case CycleState::kMoveToLowerShelf:
+      return "MOVE_TO_LOWER_SHELF";
+    case CycleState::kPlaceOnLowerShelf:
+      return "PLACE_ON_LOWER_SHELF";
+    case CycleState::kReleaseOnLowerShelf:
+      return "RELEASE_ON_LOWER_SHELF";
+    case CycleState::kRetreatFromLowerShelf:
+      return "RETREAT_FROM_LOWER_SHELF";
+    case CycleState::kDone:
+      return "DONE";
+    case CycleState::kAborted:
+      return "ABORTED";
   }
   return "?";
 }
@@ -185,9 +225,15 @@ void LibraryCycle::persist() {
   progress_changed_ = true;
 }
 
-Eigen::Isometry3d LibraryCycle::cart_frame() const { return cart_grasp_frame(*cart_marker_, s_.geometry); }
-Eigen::Isometry3d LibraryCycle::holder_frame() const { return holder_support_frame(*holder_marker_, s_.geometry); }
-double LibraryCycle::tcp_height() const { return tcp_height_on_book(progress_.gp_grasp, s_.geometry); }
+Eigen::Isometry3d LibraryCycle::cart_frame() const {
+  return cart_grasp_frame(*cart_marker_, s_.geometry);
+}
+Eigen::Isometry3d LibraryCycle::holder_frame() const {
+  return holder_support_frame(*holder_marker_, s_.geometry);
+}
+double LibraryCycle::tcp_height() const {
+  return tcp_height_on_book(progress_.gp_grasp, s_.geometry);
+}
 
 void LibraryCycle::advance_time(int64_t utime) {
   if (utime > now_) now_ = utime;
@@ -213,7 +259,8 @@ void LibraryCycle::check_timeout() {
   if (motion_.kind == MotionKind::kPlanned && motion_.planning) {
     fail("timeout in " + what + ": no PLAN_RESULT within " + std::to_string(s_.plan_timeout_s) + " s");
   } else if (motion_.kind != MotionKind::kNone) {
-    if (motion_.executing || motion_.kind == MotionKind::kLinear) out_.push_back(make_request(CycleRequest::Kind::kArmStop));
+    if (motion_.executing || motion_.kind == MotionKind::kLinear)
+      out_.push_back(make_request(CycleRequest::Kind::kArmStop));
     fail("timeout in " + what + ": the motion did not finish in time");
   } else {
     fail("timeout in " + what);
@@ -285,7 +332,8 @@ void LibraryCycle::start_gripper(bool grasp) {
 
 void LibraryCycle::drive_motion(const ArmEvent& e) {
   switch (motion_.kind) {
-    case MotionKind::kNone: return;
+    case MotionKind::kNone:
+      return;
     case MotionKind::kPlanned: {
       if (motion_.planning && motion_.plan_id < 0) {
         issue_plan();
@@ -387,33 +435,71 @@ void LibraryCycle::motion_done() {
 void LibraryCycle::after_motion() {
   const CycleGeometry& g = s_.geometry;
   switch (state_) {
-    case CycleState::kBackOut: succeed(CycleState::kPark); return;
+    case CycleState::kBackOut:
+      succeed(CycleState::kPark);
+      return;
     case CycleState::kPark:
       succeed(progress_.finished ? CycleState::kDone : CycleState::kWaitP1Check);
       return;
-    case CycleState::kMoveToStripeStart: succeed(CycleState::kServoStripe); return;
-    case CycleState::kMoveToBwhStart: succeed(CycleState::kServoBook); return;
-    case CycleState::kMoveToPreGrasp: succeed(CycleState::kOpenForGrasp); return;
-    case CycleState::kOpenForGrasp: succeed(CycleState::kInsert); return;
-    case CycleState::kInsert: succeed(CycleState::kCloseGripper); return;
-    case CycleState::kCloseGripper: succeed(CycleState::kExtract); return;
-    case CycleState::kExtract: succeed(CycleState::kMoveToHolder); return;
-    case CycleState::kMoveToHolder: succeed(CycleState::kPlaceOnHolder); return;
-    case CycleState::kPlaceOnHolder: succeed(CycleState::kReleaseOnHolder); return;
+    case CycleState::kMoveToStripeStart:
+      succeed(CycleState::kServoStripe);
+      return;
+    case CycleState::kMoveToBwhStart:
+      succeed(CycleState::kServoBook);
+      return;
+    case CycleState::kMoveToPreGrasp:
+      succeed(CycleState::kOpenForGrasp);
+      return;
+    case CycleState::kOpenForGrasp:
+      succeed(CycleState::kInsert);
+      return;
+    case CycleState::kInsert:
+      succeed(CycleState::kCloseGripper);
+      return;
+    case CycleState::kCloseGripper:
+      succeed(CycleState::kExtract);
+      return;
+    case CycleState::kExtract:
+      succeed(CycleState::kMoveToHolder);
+      return;
+    case CycleState::kMoveToHolder:
+      succeed(CycleState::kPlaceOnHolder);
+      return;
+    case CycleState::kPlaceOnHolder:
+      succeed(CycleState::kReleaseOnHolder);
+      return;
     case CycleState::kReleaseOnHolder:
       progress_.place = BookPlace::kOnHolder;
       message_ = "book " + std::to_string(progress_.books_moved) + " on the holder";
       succeed(CycleState::kRetreatFromHolder);
       return;
-    case CycleState::kRetreatFromHolder: succeed(CycleState::kParkForUser); return;
-    case CycleState::kParkForUser: succeed(CycleState::kWaitUser); return;
-    case CycleState::kMoveToHolderPreGrasp: succeed(CycleState::kOpenForHolderGrasp); return;
-    case CycleState::kOpenForHolderGrasp: succeed(CycleState::kApproachHolder); return;
-    case CycleState::kApproachHolder: succeed(CycleState::kGraspFromHolder); return;
-    case CycleState::kGraspFromHolder: succeed(CycleState::kLiftFromHolder); return;
-    case CycleState::kLiftFromHolder: succeed(CycleState::kMoveToLowerShelf); return;
-    case CycleState::kMoveToLowerShelf: succeed(CycleState::kPlaceOnLowerShelf); return;
-    case CycleState::kPlaceOnLowerShelf: succeed(CycleState::kReleaseOnLowerShelf); return;
+    case CycleState::kRetreatFromHolder:
+      succeed(CycleState::kParkForUser);
+      return;
+    case CycleState::kParkForUser:
+      succeed(CycleState::kWaitUser);
+      return;
+    case CycleState::kMoveToHolderPreGrasp:
+      succeed(CycleState::kOpenForHolderGrasp);
+      return;
+    case CycleState::kOpenForHolderGrasp:
+      succeed(CycleState::kApproachHolder);
+      return;
+    case CycleState::kApproachHolder:
+      succeed(CycleState::kGraspFromHolder);
+      return;
+    case CycleState::kGraspFromHolder:
+      succeed(CycleState::kLiftFromHolder);
+      return;
+    case CycleState::kLiftFromHolder:
+      succeed(CycleState::kMoveToLowerShelf);
+      return;
+    case CycleState::kMoveToLowerShelf:
+      succeed(CycleState::kPlaceOnLowerShelf);
+      return;
+    case CycleState::kPlaceOnLowerShelf:
+      succeed(CycleState::kReleaseOnLowerShelf);
+      return;
     case CycleState::kReleaseOnLowerShelf: {
       MovedBook b;
       b.index = progress_.books_moved;
@@ -438,8 +524,11 @@ void LibraryCycle::after_motion() {
       succeed(CycleState::kRetreatFromLowerShelf);
       return;
     }
-    case CycleState::kRetreatFromLowerShelf: succeed(CycleState::kPark); return;
-    default: return;
+    case CycleState::kRetreatFromLowerShelf:
+      succeed(CycleState::kPark);
+      return;
+    default:
+      return;
   }
 }
 
@@ -521,6 +610,8 @@ void LibraryCycle::enter(CycleState s) {
       r.servo_mode = kServoBookCorner;
       r.pose = arm_ ? arm_->end_effector : bwh_start_pose(cart_frame(), bwh_start_, g);
       r.rank = rank_;
+      r.fixed_depth =
+          -g.bwh_start_z;  // the servo keeps the start's distance to the books (elbow limit nearer the robot)
       r.timeout_s = s_.servo_timeout_s;
       out_.push_back(r);
       early_decision_.reset();
@@ -588,13 +679,14 @@ void LibraryCycle::enter(CycleState s) {
               " (it stays in the gripper)");
         return;
       }
-      start_planned_pose(lower_pre_place_pose(cart_frame(), progress_.lower_next_right_y, progress_.book_width,
-                                              tcp_height(), g),
-                         true);
+      start_planned_pose(
+          lower_pre_place_pose(cart_frame(), progress_.lower_next_right_y, progress_.book_width, tcp_height(), g),
+          true);
       break;
     }
     case CycleState::kPlaceOnLowerShelf:
-      start_linear({lower_place_pose(cart_frame(), progress_.lower_next_right_y, progress_.book_width, tcp_height(), g)});
+      start_linear(
+          {lower_place_pose(cart_frame(), progress_.lower_next_right_y, progress_.book_width, tcp_height(), g)});
       break;
     case CycleState::kRetreatFromLowerShelf:
       start_linear({move_along_own_axes(arm_->end_effector, Eigen::Vector3d(0, 0, -g.lower_retreat))});
@@ -611,11 +703,10 @@ void LibraryCycle::enter(CycleState s) {
 void LibraryCycle::fail(const std::string& reason) {
   progress_.failures += 1;
   message_ = reason;
-  const bool before_grasp = in(state_, {CycleState::kWaitP1Check, CycleState::kMoveToStripeStart,
-                                        CycleState::kServoStripe, CycleState::kWaitPsCheck,
-                                        CycleState::kMoveToBwhStart, CycleState::kServoBook,
-                                        CycleState::kWaitDecision, CycleState::kMoveToPreGrasp,
-                                        CycleState::kOpenForGrasp, CycleState::kInsert, CycleState::kCloseGripper});
+  const bool before_grasp = in(
+      state_, {CycleState::kWaitP1Check, CycleState::kMoveToStripeStart, CycleState::kServoStripe,
+               CycleState::kWaitPsCheck, CycleState::kMoveToBwhStart, CycleState::kServoBook, CycleState::kWaitDecision,
+               CycleState::kMoveToPreGrasp, CycleState::kOpenForGrasp, CycleState::kInsert, CycleState::kCloseGripper});
   // A cancel also opens a new attempt in the arbiter (its P1 is no longer frozen).
   if (before_grasp || in(state_, {CycleState::kServoStripe, CycleState::kServoBook, CycleState::kWaitDecision}))
     out_.push_back(make_request(CycleRequest::Kind::kServoCancel));
@@ -693,11 +784,12 @@ std::vector<CycleRequest> LibraryCycle::on_arm(const ArmEvent& e) {
   }
   if (state_ == CycleState::kWaitMarkers) {
     if (cart_marker_ && holder_marker_) {
-      const bool holding = progress_.place == BookPlace::kInGripperFromShelf ||
-                           progress_.place == BookPlace::kInGripperFromHolder;
+      const bool holding =
+          progress_.place == BookPlace::kInGripperFromShelf || progress_.place == BookPlace::kInGripperFromHolder;
       if (holding && !e.gripper_contact) {
-        abort("book " + std::to_string(progress_.books_moved) + " should be in the gripper (progress file: " +
-              book_place_name(progress_.place) + ") but the gripper reports no contact: find the book, correct "
+        abort("book " + std::to_string(progress_.books_moved) +
+              " should be in the gripper (progress file: " + book_place_name(progress_.place) +
+              ") but the gripper reports no contact: find the book, correct "
               "the progress file, restart");
       } else {
         succeed(resume_target());

@@ -25,6 +25,7 @@ void usage(std::ostream& os) {
         "  --coordinator FILE  coordinator YAML (default config/services/coordinator.yaml)\n"
         "  --urdf FILE         robot description (default: the scene's robot.urdf)\n"
         "  --set KEY=VALUE     override a coordinator key (dotted, e.g. geometry.grasp.extract_retreat_m=0.31)\n"
+        "  --planner-ik FILE   the IK settings of a planner YAML (ik:) instead of 24 restarts from defaults\n"
         "  --verbose           every stage of every scene with the elbow bend it needs\n"
         "  --source-dir DIR    project tree (default: the one this tool was built from)\n";
 }
@@ -53,7 +54,7 @@ int main(int argc, char** argv) {
   int scenes = -1;
   long long seed = -1;
   bool verbose = false;
-  std::string source_dir = BOOKGRASP_SOURCE_DIR, scene_file, coord_file, urdf;
+  std::string source_dir = BOOKGRASP_SOURCE_DIR, scene_file, coord_file, urdf, planner_ik;
   std::vector<std::string> sets;
   try {
     for (int i = 1; i < argc; ++i) {
@@ -74,6 +75,8 @@ int main(int argc, char** argv) {
         urdf = value();
       else if (a == "--set")
         sets.push_back(value());
+      else if (a == "--planner-ik")
+        planner_ik = value();
       else if (a == "--verbose")
         verbose = true;
       else if (a == "--source-dir")
@@ -108,6 +111,21 @@ int main(int argc, char** argv) {
       IkParams p;
       p.max_restarts = 24;
       p.seed = s;
+      if (!planner_ik.empty()) {
+        const Config ik = Config::load_file(planner_ik).child("ik");
+        p.max_iterations = ik.get_int("max_iterations", 1, 100000);
+        p.max_restarts = ik.get_int("max_restarts", 0, 1000);
+        p.position_tolerance_m = ik.get_double("position_tolerance_m", 1e-9, 0.1);
+        p.orientation_tolerance_rad = ik.get_double("orientation_tolerance_rad", 1e-9, 1.0);
+        p.damping = ik.get_double("damping", 1e-9, 10.0);
+        p.max_step_rad = ik.get_double("max_step_rad", 1e-6, 3.2);
+        p.nullspace_gain = ik.get_double("nullspace_gain", 0.0, 1.0);
+        p.posture_iterations = ik.get_int("posture_iterations", 0, 100000);
+        p.orientation_weight_m = ik.get_double("orientation_weight_m", 1e-6, 100.0);
+        const std::vector<double> pp = ik.get_vector("preferred_posture", 7);
+        p.preferred_posture = Eigen::Map<const Eigen::VectorXd>(pp.data(), 7);
+        p.seed = static_cast<uint64_t>(ik.get_int("seed", 0, 1 << 30));
+      }
       const InverseKinematics ik(kin, p);
       Eigen::VectorXd q0(7);
       for (int j = 0; j < 7; ++j) q0[j] = park[j] * M_PI / 180.0;
@@ -125,6 +143,22 @@ int main(int argc, char** argv) {
       std::printf("seed %llu: book y %+.3f m (base), height %.3f m: %s\n", static_cast<unsigned long long>(s),
                   b.pose.translation().y(), b.height_m,
                   failed.empty() ? "all reachable" : ("UNREACHABLE " + failed).c_str());
+      if (verbose) {
+        // The frames the coordinator derives from the markers (AprilTag axes: y down, z into the tag) vs the truth.
+        const Eigen::Isometry3d flip(Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitX()));
+        const Eigen::Isometry3d sup = holder_support_frame(scene.holder_marker.pose * flip, g);
+        const Eigen::Isometry3d grf = cart_grasp_frame(scene.cart_marker.pose * flip, g);
+        const Eigen::Isometry3d gt = true_grasp_frame(scene);
+        std::printf("    holder support from its marker - truth: (%+.4f %+.4f %+.4f) m, %.4f rad\n",
+                    (sup.translation() - scene.holder_support_pose.translation()).x(),
+                    (sup.translation() - scene.holder_support_pose.translation()).y(),
+                    (sup.translation() - scene.holder_support_pose.translation()).z(),
+                    Eigen::AngleAxisd(sup.linear().transpose() * scene.holder_support_pose.linear()).angle());
+        std::printf("    grasp frame from the cart marker - truth: (%+.4f %+.4f %+.4f) m, %.4f rad\n",
+                    (grf.translation() - gt.translation()).x(), (grf.translation() - gt.translation()).y(),
+                    (grf.translation() - gt.translation()).z(),
+                    Eigen::AngleAxisd(grf.linear().transpose() * gt.linear()).angle());
+      }
       if (verbose)
         for (const StageReach& st : r)
           std::printf("    %-17s tcp (%+.3f %+.3f %+.3f)  elbow needs %6.1f deg  %s\n", st.stage.c_str(),

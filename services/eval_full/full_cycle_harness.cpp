@@ -9,19 +9,19 @@
 #include <sstream>
 #include <stdexcept>
 
+#include <yaml-cpp/yaml.h>
 #include <lcm/lcm-cpp.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
-#include <yaml-cpp/yaml.h>
 
+#include "bookgrasp/book_features_hand_t.hpp"
 #include "bookgrasp/grasp_point_t.hpp"
 #include "bookgrasp/hand_image_t.hpp"
 #include "bookgrasp/marker_detections_t.hpp"
-#include "bookgrasp/servo_status_t.hpp"
-#include "bookgrasp/stripe_features_t.hpp"
-#include "bookgrasp/book_features_hand_t.hpp"
 #include "bookgrasp/plan_result_t.hpp"
+#include "bookgrasp/servo_status_t.hpp"
 #include "bookgrasp/stereo_frame_t.hpp"
+#include "bookgrasp/stripe_features_t.hpp"
 #include "common/composition.h"
 #include "common/config.h"
 #include "common/image_conversion.h"
@@ -66,8 +66,7 @@ struct ServiceYaml {
       if (!next.IsMap()) throw std::runtime_error(path + ": no section '" + parts[i] + "' for override " + dotted);
       chain.push_back(next);
     }
-    if (!chain.back()[parts.back()].IsDefined())
-      throw std::runtime_error(path + ": override of unknown key " + dotted);
+    if (!chain.back()[parts.back()].IsDefined()) throw std::runtime_error(path + ": override of unknown key " + dotted);
     chain.back()[parts.back()] = value;
   }
   std::string text() const {
@@ -78,9 +77,13 @@ struct ServiceYaml {
   Config config() const { return Config::from_string(text(), path); }
 };
 
-double norm_finite(const double* v) { return std::isfinite(v[0]) && std::isfinite(v[1]) && std::isfinite(v[2]) ? 1 : 0; }
+double norm_finite(const double* v) {
+  return std::isfinite(v[0]) && std::isfinite(v[1]) && std::isfinite(v[2]) ? 1 : 0;
+}
 
-Eigen::Vector3d vec3(const double* v) { return Eigen::Vector3d(v[0], v[1], v[2]); }
+Eigen::Vector3d vec3(const double* v) {
+  return Eigen::Vector3d(v[0], v[1], v[2]);
+}
 
 std::string fmt(const char* f, double a) {
   char b[64];
@@ -162,14 +165,10 @@ struct FullCycleHarness::Impl {
     add(hand_y, factories::hand_camera);
 
     add(ServiceYaml(cfg + "marker_detector.yaml"), factories::marker_detector);
-    add(ServiceYaml(cfg + "bws_detector.yaml"),
-        factories::bws_detector);
-    add(ServiceYaml(cfg + "bwh_detector.yaml"),
-        factories::bwh_detector);
-    add(ServiceYaml(cfg + "bswh_detector.yaml"),
-        factories::bswh_detector);
-    add(ServiceYaml(cfg + "visual_servo.yaml"),
-        factories::visual_servo);
+    add(ServiceYaml(cfg + "bws_detector.yaml"), factories::bws_detector);
+    add(ServiceYaml(cfg + "bwh_detector.yaml"), factories::bwh_detector);
+    add(ServiceYaml(cfg + "bswh_detector.yaml"), factories::bswh_detector);
+    add(ServiceYaml(cfg + "visual_servo.yaml"), factories::visual_servo);
     add(ServiceYaml(cfg + "arbiter.yaml"), factories::arbiter);
     ServiceYaml plan_y(cfg + "planner.yaml");
     ch_plan = plan_y.root["channels"]["plan_result"].as<std::string>();
@@ -279,8 +278,20 @@ struct FullCycleHarness::Impl {
   }
   void on_markers(const lcm::ReceiveBuffer*, const std::string&, const marker_detections_t* m) {
     std::string roles;
-    for (const auto& k : m->markers) roles += (roles.empty() ? "" : ",") + (k.role.empty() ? std::to_string(k.id) : k.role);
-    if (roles != marker_roles) trace("MARKERS now: [" + roles + "]");
+    for (const auto& k : m->markers)
+      roles += (roles.empty() ? "" : ",") + (k.role.empty() ? std::to_string(k.id) : k.role);
+    if (roles != marker_roles) {
+      std::string poses;
+      for (const auto& k : m->markers) {
+        const auto& p = k.pose_in_base;
+        char b[200];
+        std::snprintf(b, sizeof b, " %s at (%.3f %.3f %.3f) q (%.3f %.3f %.3f %.3f);", k.role.c_str(), p.position[0],
+                      p.position[1], p.position[2], p.orientation[0], p.orientation[1], p.orientation[2],
+                      p.orientation[3]);
+        poses += b;
+      }
+      trace("MARKERS now: [" + roles + "]" + poses);
+    }
     marker_roles = roles;
   }
   void on_servo(const lcm::ReceiveBuffer*, const std::string&, const servo_status_t* m) {
@@ -376,8 +387,8 @@ struct FullCycleHarness::Impl {
         ++b.grasp_successes;
         ++res.grasp_successes;
       }
-      trace(std::string("GRASP ") + (held ? "held" : "FAILED") + ": book id " + std::to_string(b.truth_id) +
-            " is " + (tb ? tb->place : std::string("unknown")));
+      trace(std::string("GRASP ") + (held ? "held" : "FAILED") + ": book id " + std::to_string(b.truth_id) + " is " +
+            (tb ? tb->place : std::string("unknown")));
     } else if (in_extract && m->state != "EXTRACT" && m->state != "CLOSE_GRIPPER") {
       in_extract = false;  // the close itself failed (nothing grasped); counted as a failed attempt
       trace("GRASP FAILED at close: " + m->message);
@@ -460,7 +471,9 @@ struct FullCycleHarness::Impl {
 FullCycleHarness::FullCycleHarness(const FullCycleOptions& options) : impl_(std::make_unique<Impl>(options)) {}
 FullCycleHarness::~FullCycleHarness() = default;
 
-void FullCycleHarness::step() { impl_->step(); }
+void FullCycleHarness::step() {
+  impl_->step();
+}
 
 std::string FullCycleHarness::run_until(double budget_s, int max_books, const std::function<bool()>& stop) {
   const int64_t end = impl_->t + static_cast<int64_t>(budget_s * 1e6);
@@ -476,11 +489,21 @@ std::string FullCycleHarness::run_until(double budget_s, int max_books, const st
   return word;
 }
 
-void FullCycleHarness::restart_coordinator() { impl_->restart_coordinator(); }
-const task_status_t& FullCycleHarness::status() const { return impl_->status; }
-const ground_truth_t& FullCycleHarness::truth() const { return impl_->truth; }
-double FullCycleHarness::sim_time_s() const { return impl_->rel_s(impl_->t); }
-FullCycleResult FullCycleHarness::result() const { return impl_->result(); }
+void FullCycleHarness::restart_coordinator() {
+  impl_->restart_coordinator();
+}
+const task_status_t& FullCycleHarness::status() const {
+  return impl_->status;
+}
+const ground_truth_t& FullCycleHarness::truth() const {
+  return impl_->truth;
+}
+double FullCycleHarness::sim_time_s() const {
+  return impl_->rel_s(impl_->t);
+}
+FullCycleResult FullCycleHarness::result() const {
+  return impl_->result();
+}
 cv::Mat FullCycleHarness::last_stereo_left() const {
   return impl_->have_stereo ? image_to_mat(impl_->last_stereo.left).clone() : cv::Mat();
 }

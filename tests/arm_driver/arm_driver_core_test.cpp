@@ -5,7 +5,7 @@
 namespace bookgrasp {
 namespace {
 
-ArmDriverCore make_core() {
+ArmDriverCore make_core(double nullspace_gain = 0.0, const Eigen::VectorXd& preferred = Eigen::VectorXd()) {
   ArmKinematics kin = ArmKinematics::from_urdf_file(std::string(BOOKGRASP_SOURCE_DIR) + "/config/robot/lwa3_pg70.urdf",
                                                     "base", "gripper");
   ArmLimits l;
@@ -21,6 +21,8 @@ ArmDriverCore make_core() {
   l.max_angular_speed = 0.6;
   DriverParams p;
   p.heartbeat_timeout_s = 0.5;
+  p.nullspace_gain = nullspace_gain;
+  p.preferred_posture = preferred;
   return ArmDriverCore(std::move(kin), l, p);
 }
 
@@ -126,6 +128,46 @@ TEST(ArmDriverCore, CartesianVelocityMovesTheGripperAsCommanded) {
   EXPECT_NEAR(p1.y() - p0.y(), -0.01, 0.001);
   EXPECT_NEAR(p1.z() - p0.z(), 0.0, 0.001);
   EXPECT_EQ(d.state(), DriverState::kExecuting);
+}
+
+// The null-space term moves the redundant joints towards the preferred posture without moving the TCP (forward
+// kinematics of the streamed setpoint is the ground truth), and leaves a commanded twist followed.
+TEST(ArmDriverCore, NullspacePullKeepsTheTcpAndApproachesThePreferredPosture) {
+  Eigen::VectorXd start = home();
+  start[0] = 0.4;  // the swivel (arm_1 / arm_3 / arm_5) away from the preferred posture
+  start[2] = -0.5;
+  start[4] = 0.5;
+  ArmDriverCore d = make_core(0.5, home());
+  d.on_measurement(kT0, start, 0.06);
+  const Eigen::Isometry3d tip0 = d.kinematics().tip_pose(start);
+  ASSERT_EQ(d.command_cartesian_velocity(Eigen::Matrix<double, 6, 1>::Zero(), "base", 1), "");
+  DriverSetpoint sp;
+  d.update(kT0);
+  for (int64_t t = kT0 + 10000; t <= kT0 + 3000000; t += 10000) {
+    d.heartbeat();
+    sp = d.update(t);
+  }
+  const Eigen::Isometry3d tip1 = d.kinematics().tip_pose(sp.q);
+  EXPECT_LT((tip1.translation() - tip0.translation()).norm(), 0.002) << "the TCP stays";
+  EXPECT_LT(Eigen::AngleAxisd(tip0.linear().transpose() * tip1.linear()).angle(), 0.01);
+  EXPECT_LT((sp.q - home()).norm(), 0.8 * (start - home()).norm()) << "the posture approaches the preferred one";
+  EXPECT_EQ(d.state(), DriverState::kExecuting);
+
+  // A twist is still followed (2 cm/s forward for 1 s) while the pull acts.
+  ArmDriverCore e = make_core(0.5, home());
+  e.on_measurement(kT0, start, 0.06);
+  Eigen::Matrix<double, 6, 1> tw = Eigen::Matrix<double, 6, 1>::Zero();
+  tw[0] = 0.02;
+  ASSERT_EQ(e.command_cartesian_velocity(tw, "base", 2), "");
+  e.update(kT0);
+  for (int64_t t = kT0 + 10000; t <= kT0 + 1000000; t += 10000) {
+    e.heartbeat();
+    sp = e.update(t);
+  }
+  const Eigen::Vector3d dp = e.kinematics().tip_pose(sp.q).translation() - tip0.translation();
+  EXPECT_NEAR(dp.x(), 0.02, 0.002);
+  EXPECT_NEAR(dp.y(), 0.0, 0.002);
+  EXPECT_NEAR(dp.z(), 0.0, 0.002);
 }
 
 TEST(ArmDriverCore, BadCartesianAndGripperCommandsAreRefused) {

@@ -4,6 +4,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <fstream>
+#include <sstream>
 
 #include "bookgrasp/arm_command_t.hpp"
 #include "bookgrasp/arm_state_t.hpp"
@@ -119,8 +121,7 @@ TEST_F(DriverInSimulation, ExecutesAPlannedTrajectoryToItsGoal) {
   const Eigen::VectorXd err = measured() - goal_pose();
   EXPECT_LT(err.cwiseAbs().maxCoeff(), 0.01) << "joint error (rad): " << err.transpose();
   // The gripper where forward kinematics puts the goal, within 1 mm.
-  const ArmKinematics kin =
-      ArmKinematics::from_urdf_file(kSrc + "/config/robot/lwa3_pg70.urdf", "base", "gripper");
+  const ArmKinematics kin = ArmKinematics::from_urdf_file(kSrc + "/config/robot/lwa3_pg70.urdf", "base", "gripper");
   const Eigen::Vector3d want = kin.tip_pose(goal_pose()).translation();
   const Eigen::Vector3d got(s.end_effector.position[0], s.end_effector.position[1], s.end_effector.position[2]);
   EXPECT_LT((got - want).norm(), 0.001) << "TCP " << got.transpose() << " vs goal " << want.transpose();
@@ -164,6 +165,32 @@ TEST(DriverAndPlannerConfigs, PlannerLimitsLieWithinTheDriverLimits) {
   }
   EXPECT_TRUE(ps.scene.tool_min.isApprox(core.limits().workspace_min));
   EXPECT_TRUE(ps.scene.tool_max.isApprox(core.limits().workspace_max));
+}
+
+}  // namespace
+}  // namespace bookgrasp
+
+namespace bookgrasp {
+namespace {
+
+// A preferred posture outside the joint limits is a configuration error naming the key.
+TEST(DriverConfig, NullspacePostureOutsideTheLimitsIsRefused) {
+  std::ifstream in(kSrc + "/config/services/arm_driver.yaml");
+  std::stringstream ss;
+  ss << in.rdbuf();
+  std::string text = ss.str();
+  const std::string good = "preferred_posture: [0.0, 0.6, 0.0, 1.5, 0.0, 0.6, 0.0]";
+  const auto at = text.find(good);
+  ASSERT_NE(at, std::string::npos) << "arm_driver.yaml changed: update this test";
+  EXPECT_NO_THROW(make_arm_driver_core(Config::from_string(text, "arm_driver.yaml")));
+  text.replace(at, good.size(), "preferred_posture: [0.0, 0.6, 0.0, 2.5, 0.0, 0.6, 0.0]");
+  try {
+    make_arm_driver_core(Config::from_string(text, "arm_driver.yaml"));
+    FAIL() << "no error";
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("cartesian_nullspace.preferred_posture"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("joint 4"), std::string::npos) << e.what();
+  }
 }
 
 }  // namespace

@@ -56,18 +56,42 @@ TEST(LibraryCycle, ThreeBooksWholeCycleEveryTransitionAndPlacements) {
 
   // Book 0 (first run, BSwH for PS), by hand from the state machine's definition.
   // (The markers arrive before the first arm state, so WAIT_MARKERS is left within that first event.)
-  const std::vector<std::string> first = {
-      "START", "PARK", "WAIT_P1_CHECK", "MOVE_TO_STRIPE_START", "SERVO_STRIPE", "WAIT_PS_CHECK",
-      "MOVE_TO_BWH_START", "SERVO_BOOK", "WAIT_DECISION", "MOVE_TO_PRE_GRASP", "OPEN_FOR_GRASP", "INSERT",
-      "CLOSE_GRIPPER", "EXTRACT", "MOVE_TO_HOLDER", "PLACE_ON_HOLDER", "RELEASE_ON_HOLDER", "RETREAT_FROM_HOLDER",
-      "PARK_FOR_USER", "WAIT_USER", "MOVE_TO_HOLDER_PRE_GRASP", "OPEN_FOR_HOLDER_GRASP", "APPROACH_HOLDER",
-      "GRASP_FROM_HOLDER", "LIFT_FROM_HOLDER", "MOVE_TO_LOWER_SHELF", "PLACE_ON_LOWER_SHELF",
-      "RELEASE_ON_LOWER_SHELF", "RETREAT_FROM_LOWER_SHELF", "PARK", "WAIT_P1_CHECK"};
+  const std::vector<std::string> first = {"START",
+                                          "PARK",
+                                          "WAIT_P1_CHECK",
+                                          "MOVE_TO_STRIPE_START",
+                                          "SERVO_STRIPE",
+                                          "WAIT_PS_CHECK",
+                                          "MOVE_TO_BWH_START",
+                                          "SERVO_BOOK",
+                                          "WAIT_DECISION",
+                                          "MOVE_TO_PRE_GRASP",
+                                          "OPEN_FOR_GRASP",
+                                          "INSERT",
+                                          "CLOSE_GRIPPER",
+                                          "EXTRACT",
+                                          "MOVE_TO_HOLDER",
+                                          "PLACE_ON_HOLDER",
+                                          "RELEASE_ON_HOLDER",
+                                          "RETREAT_FROM_HOLDER",
+                                          "PARK_FOR_USER",
+                                          "WAIT_USER",
+                                          "MOVE_TO_HOLDER_PRE_GRASP",
+                                          "OPEN_FOR_HOLDER_GRASP",
+                                          "APPROACH_HOLDER",
+                                          "GRASP_FROM_HOLDER",
+                                          "LIFT_FROM_HOLDER",
+                                          "MOVE_TO_LOWER_SHELF",
+                                          "PLACE_ON_LOWER_SHELF",
+                                          "RELEASE_ON_LOWER_SHELF",
+                                          "RETREAT_FROM_LOWER_SHELF",
+                                          "PARK",
+                                          "WAIT_P1_CHECK"};
   ASSERT_GE(w.states.size(), first.size());
   EXPECT_EQ(std::vector<std::string>(w.states.begin(), w.states.begin() + first.size()), first);
   // Book 1: PS known from PS.y = GP.y - BW, so no stripe servo: straight to BwH.
-  const auto second = slice(std::vector<std::string>(w.states.begin() + first.size() - 1, w.states.end()),
-                            "WAIT_P1_CHECK", 3);
+  const auto second =
+      slice(std::vector<std::string>(w.states.begin() + first.size() - 1, w.states.end()), "WAIT_P1_CHECK", 3);
   EXPECT_EQ(second, (std::vector<std::string>{"WAIT_P1_CHECK", "MOVE_TO_BWH_START", "SERVO_BOOK"}));
   // End: BwS finds nothing -> BSwH -> stripe end at the shelf's left end -> park -> DONE.
   const std::vector<std::string> tail(w.states.end() - 6, w.states.end());
@@ -102,12 +126,12 @@ TEST(LibraryCycle, ThreeBooksWholeCycleEveryTransitionAndPlacements) {
     EXPECT_NEAR(tcp.y(), -0.05 - ys[i], 0.0015) << "book " << i;
     EXPECT_NEAR(tcp.z(), -0.32 + hs[i] + 0.005, 0.0015) << "book " << i;
   }
-  // Holder: support origin (0.301, 0.28, -0.09), base axes; TCP (-0.02, -0.215, h + 0.005) in it (coordinator.yaml
+  // Holder: support origin (0.301, 0.28, -0.09), base axes; TCP (-0.02, -0.24, h + 0.005) in it (coordinator.yaml
   // holder.place_tcp_in_support_m: the fingers beyond the back plate's right edge).
   ASSERT_EQ(w.holder_drops.size(), 3u);
   const Eigen::Vector3d h0 = w.holder_drops[0].second.translation();
   EXPECT_NEAR(h0.x(), 0.281, 0.0015);
-  EXPECT_NEAR(h0.y(), 0.065, 0.0015);
+  EXPECT_NEAR(h0.y(), 0.04, 0.0015);
   EXPECT_NEAR(h0.z(), -0.09 + 0.25 + 0.005, 0.0015);
   // Gripper axes on the holder: x up (base z), y = base x (gripper_y_in_support), z = x cross y = base y.
   const Eigen::Matrix3d r = w.holder_drops[0].second.linear();
@@ -138,9 +162,9 @@ TEST(LibraryCycle, ThreeBooksWholeCycleEveryTransitionAndPlacements) {
 
 TEST(LibraryCycle, RetriesNextRegionNoGraspMissedGraspAndPlanFailure) {
   FakeLibrary w(three_books());
-  w.next_region_once = 1;   // BwH rank 0 picks a false region once
+  w.next_region_once = 1;  // BwH rank 0 picks a false region once
   w.no_grasp_once = 0;
-  w.missed_grasps = 1;      // the first close finds nothing
+  w.missed_grasps = 1;                    // the first close finds nothing
   w.plan_failures["MOVE_TO_HOLDER"] = 1;  // one step retry with the book in the gripper
   LibraryCycle cycle(settings(), std::nullopt);
   w.run(cycle, [&] { return done_or_aborted(cycle); });
@@ -281,17 +305,13 @@ void resume_at(const std::function<bool(const LibraryCycle&, const FakeLibrary&)
 TEST(LibraryCycle, ResumeFromPersistedFileMidCycleAccountsForEveryBook) {
   resume_at([](const LibraryCycle& c, const FakeLibrary&) { return c.state() == CycleState::kMoveToHolder; },
             "book_in_gripper");
-  resume_at([](const LibraryCycle& c, const FakeLibrary&) { return c.state() == CycleState::kExtract; },
-            "extracting");
-  resume_at(
-      [](const LibraryCycle& c, const FakeLibrary&) {
-        return c.state() == CycleState::kWaitUser && c.progress().books_moved == 1;
-      },
-      "second_book_on_holder");
+  resume_at([](const LibraryCycle& c, const FakeLibrary&) { return c.state() == CycleState::kExtract; }, "extracting");
+  resume_at([](const LibraryCycle& c,
+               const FakeLibrary&) { return c.state() == CycleState::kWaitUser && c.progress().books_moved == 1; },
+            "second_book_on_holder");
   resume_at([](const LibraryCycle& c, const FakeLibrary&) { return c.state() == CycleState::kLiftFromHolder; },
             "taken_from_holder");
-  resume_at([](const LibraryCycle& c, const FakeLibrary&) { return c.state() == CycleState::kInsert; },
-            "inserting");
+  resume_at([](const LibraryCycle& c, const FakeLibrary&) { return c.state() == CycleState::kInsert; }, "inserting");
 }
 
 TEST(LibraryCycle, ResumeWithABookExpectedInTheGripperButNoContactAborts) {
@@ -302,7 +322,8 @@ TEST(LibraryCycle, ResumeWithABookExpectedInTheGripperButNoContactAborts) {
   w.contact = false;  // the book fell out while the coordinator was down
   w.in_gripper.reset();
   LibraryCycle second(settings(), p);
-  w.run(second, [&] { return done_or_aborted(second); }, 1000);
+  w.run(
+      second, [&] { return done_or_aborted(second); }, 1000);
   ASSERT_EQ(second.state(), CycleState::kAborted);
   EXPECT_NE(second.status().message.find("no contact"), std::string::npos) << second.status().message;
 }
@@ -328,10 +349,11 @@ TEST(TaskProgress, RoundTripAndCorruptFilesAreNamed) {
   EXPECT_EQ(q.moved[0].lower_right_y, 0.37);
   EXPECT_THROW(bookgrasp::progress_from_yaml("books_moved: 1\n", "x"), std::runtime_error);
   try {
-    bookgrasp::progress_from_yaml("books_moved: 2\nfailures: 0\nplace: holder\nhave_book_data: false\n"
-                                  "gp_grasp: [0, 0, 0]\nbook_width: 0\nlower_next_right_y: 0\nfinished: false\n"
-                                  "last_state: PARK\nmoved: []\n",
-                                  "f.yaml");
+    bookgrasp::progress_from_yaml(
+        "books_moved: 2\nfailures: 0\nplace: holder\nhave_book_data: false\n"
+        "gp_grasp: [0, 0, 0]\nbook_width: 0\nlower_next_right_y: 0\nfinished: false\n"
+        "last_state: PARK\nmoved: []\n",
+        "f.yaml");
     FAIL();
   } catch (const std::runtime_error& e) {
     EXPECT_NE(std::string(e.what()).find("books_moved"), std::string::npos) << e.what();
