@@ -9,6 +9,7 @@ namespace bookgrasp {
 namespace {
 
 constexpr int kArmIdle = 0;
+constexpr int kArmExecuting = 1;
 constexpr int kArmStopped = 2;
 constexpr int kArmFault = 3;
 constexpr int kServoBookCorner = 1;
@@ -248,8 +249,12 @@ void LibraryCycle::check_timeout() {
   deadline_ = -1;
   const std::string what = cycle_state_name(state_);
   if (state_ == CycleState::kWaitMarkers) {
-    abort("timeout in WAIT_MARKERS: cart and holder markers not both seen within " +
-          std::to_string(s_.markers_timeout_s) + " s (is marker_detector running, are the tags in view?)");
+    if (cart_marker_ && holder_marker_)
+      abort("timeout in WAIT_MARKERS: the arm is still executing a motion the coordinator did not start, " +
+            std::string("and did not stop on ARM_COMMAND STOP within ") + std::to_string(s_.markers_timeout_s) + " s");
+    else
+      abort("timeout in WAIT_MARKERS: cart and holder markers not both seen within " +
+            std::to_string(s_.markers_timeout_s) + " s (is marker_detector running, are the tags in view?)");
     return;
   }
   if (state_ == CycleState::kWaitUser) {
@@ -780,10 +785,16 @@ std::vector<CycleRequest> LibraryCycle::on_arm(const ArmEvent& e) {
   if (state_ == CycleState::kStart) {
     out_.push_back(make_request(CycleRequest::Kind::kServoCancel));
     out_.back().id = next_id();
+    // A (re)started coordinator does not own a motion the arm may still be executing (its killed
+    // predecessor's, until the driver's heartbeat timeout): stop it, and plan nothing from a moving arm.
+    if (e.state == kArmExecuting) {
+      out_.push_back(make_request(CycleRequest::Kind::kArmStop));
+      message_ = "stopping the arm's unfinished motion before resuming";
+    }
     enter(CycleState::kWaitMarkers);
   }
   if (state_ == CycleState::kWaitMarkers) {
-    if (cart_marker_ && holder_marker_) {
+    if (cart_marker_ && holder_marker_ && e.state != kArmExecuting) {
       const bool holding =
           progress_.place == BookPlace::kInGripperFromShelf || progress_.place == BookPlace::kInGripperFromHolder;
       if (holding && !e.gripper_contact) {

@@ -314,6 +314,34 @@ TEST(LibraryCycle, ResumeFromPersistedFileMidCycleAccountsForEveryBook) {
   resume_at([](const LibraryCycle& c, const FakeLibrary&) { return c.state() == CycleState::kInsert; }, "inserting");
 }
 
+TEST(LibraryCycle, ARestartDuringAPlannedMotionStopsTheArmBeforePlanning) {
+  // The first coordinator dies while the arm executes its trajectory to the stripe station; the
+  // driver would go on until its heartbeat timeout. The new one must stop that motion and plan
+  // nothing until the arm no longer executes (a plan from a moving arm is refused by the driver).
+  FakeLibrary w(three_books());
+  auto first = std::make_unique<LibraryCycle>(settings(), std::nullopt);
+  w.run(*first, [&] { return first->state() == CycleState::kMoveToStripeStart && w.arm_state == 1; });
+  ASSERT_EQ(w.arm_state, 1);
+  const auto progress = first->progress();
+  first.reset();
+  LibraryCycle second(settings(), progress);
+  const size_t before = w.requests.size();
+  w.run(second, [&] { return second.state() != CycleState::kStart && second.state() != CycleState::kWaitMarkers; });
+  bool stopped = false;
+  for (size_t i = before; i < w.requests.size(); ++i) {
+    const auto& q = w.requests[i];
+    if (q.kind == CycleRequest::Kind::kArmStop) stopped = true;
+    if (q.kind == CycleRequest::Kind::kPlan || q.kind == CycleRequest::Kind::kExecutePlan ||
+        q.kind == CycleRequest::Kind::kTwist) {
+      EXPECT_TRUE(stopped) << "a motion request before the unfinished motion was stopped";
+    }
+  }
+  EXPECT_TRUE(stopped);
+  w.run(second, [&] { return done_or_aborted(second); });
+  ASSERT_EQ(second.state(), CycleState::kDone) << second.status().message;
+  EXPECT_EQ(w.lower.size(), 3u);
+}
+
 TEST(LibraryCycle, ResumeWithABookExpectedInTheGripperButNoContactAborts) {
   FakeLibrary w(three_books());
   LibraryCycle first(settings(), std::nullopt);
