@@ -414,8 +414,13 @@ struct FullCycleHarness::Impl {
         d.p1_true_grasp = true_grasp(vec3(tb->p1_base));
       }
       res.decisions.push_back(d);
-    } else if (word == "BOOK_WIDTH" && m->num_steps > 0) {
-      book(status.current_book).measured_width_m = m->steps[0].value_m;
+    } else if (word == "BOOK_WIDTH") {
+      // The width check's step (the arbiter may put other steps, e.g. a follow note, before it).
+      for (const auto& st : m->steps)
+        if (st.rule.find("book width") != std::string::npos) {
+          book(status.current_book).measured_width_m = st.value_m;
+          break;
+        }
     }
   }
 

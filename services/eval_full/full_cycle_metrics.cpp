@@ -44,7 +44,7 @@ std::string failure_reason(const FullCycleResult& r, int max_books) {
     const std::string state = in == std::string::npos ? "?" : first_words(r.message.substr(in + 11), 1);
     const auto last = r.message.find("last: ");
     std::string cause = last == std::string::npos ? r.message : r.message.substr(last + 6);
-    cause = cause.substr(0, cause.find(" within"));   // drop run-specific numbers
+    cause = cause.substr(0, cause.find(" within"));  // drop run-specific numbers
     cause = cause.substr(0, cause.find(" after "));
     return "ABORTED in " + state + ": " + first_words(cause, 16);
   }
@@ -95,7 +95,7 @@ void accumulate(const SceneOutcome& o, int max_books, const MetricTolerances& to
       for (int k = 0; k < 3; ++k) m->p1_error_mm[k].push_back(std::abs(d.p1_grasp[k] - d.p1_true_grasp[k]) * 1e3);
   }
   for (const auto& b : r.books) {
-    if (b.measured_width_m >= 0 && b.truth_id >= 0) {
+    if (b.measured_width_m >= 0 && b.truth_id >= 0 && b.grasp_successes > 0) {  // plates on a held book only
       ++m->widths;
       const double e = std::abs(b.measured_width_m - b.true_width_m);
       m->width_error_mm.push_back(e * 1e3);
@@ -120,7 +120,9 @@ std::string num(double v) {
   return b;
 }
 
-std::string rate(int k, int n) { return n > 0 ? num(static_cast<double>(k) / n) : "null"; }
+std::string rate(int k, int n) {
+  return n > 0 ? num(static_cast<double>(k) / n) : "null";
+}
 
 std::string esc(const std::string& s) {
   std::string o;

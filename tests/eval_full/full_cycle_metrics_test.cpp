@@ -21,7 +21,7 @@ SceneOutcome done_scene(uint64_t seed) {
   r.end = "DONE";
   r.books_on_upper_shelf = 2;
   r.books_moved = 2;
-  r.grasp_attempts = 3;   // one retry
+  r.grasp_attempts = 3;  // one retry
   r.grasp_successes = 2;
   r.final_truth.books = {truth_book("lower_shelf"), truth_book("lower_shelf")};
   r.final_truth.num_books = 2;
@@ -29,6 +29,8 @@ SceneOutcome done_scene(uint64_t seed) {
   a.truth_id = 0;
   a.true_width_m = 0.020;
   a.measured_width_m = 0.023;  // 3 mm
+  a.grasp_attempts = 1;
+  a.grasp_successes = 1;  // the plates closed on the book (physics)
   a.moved = true;
   a.start_s = 0;
   a.end_s = 100;
@@ -37,7 +39,12 @@ SceneOutcome done_scene(uint64_t seed) {
   b.measured_width_m = 0.035;  // 15 mm: outside 1 cm
   b.start_s = 100;
   b.end_s = 220;
-  r.books = {a, b};
+  BookRecord c;  // a close on nothing: its plate distance is no book width and is not counted
+  c.truth_id = 2;
+  c.true_width_m = 0.020;
+  c.measured_width_m = 0.0;
+  c.grasp_attempts = 1;
+  r.books = {a, b, c};
   GraspDecisionRecord d;
   d.p1_present = true;
   d.p1_grasp = {0.20, 0.10, 0.01};
@@ -72,7 +79,7 @@ TEST(FullCycleMetrics, AccumulatesRatesAndErrors) {
   EXPECT_EQ(m.books_moved, 2);
   EXPECT_EQ(m.grasp_attempts, 3);
   EXPECT_EQ(m.grasp_successes, 2);
-  EXPECT_EQ(m.decisions, 2);           // the decision without P1 is not an agreement sample
+  EXPECT_EQ(m.decisions, 2);  // the decision without P1 is not an agreement sample
   EXPECT_EQ(m.decisions_agreeing, 1);
   EXPECT_EQ(m.widths, 2);
   EXPECT_EQ(m.widths_within, 1);
@@ -99,8 +106,9 @@ TEST(FullCycleMetrics, FailureReasons) {
   r.trace = {"  1.00 TASK_STATUS PARK -> SERVO_STRIPE (book 0) x", "  2.00 GRASP_POINT NEED_PS"};
   EXPECT_EQ(failure_reason(r, 1), "BUDGET: stuck in SERVO_STRIPE");
   r.end = "ABORTED";
-  r.message = "aborted in SERVO_STRIPE: book 0: 3 attempts failed (retries.max_attempts_per_book), last: stripe servo "
-              "ended TIMEOUT: no convergence within 30.00 s (message time) after 289 iterations";
+  r.message =
+      "aborted in SERVO_STRIPE: book 0: 3 attempts failed (retries.max_attempts_per_book), last: stripe servo "
+      "ended TIMEOUT: no convergence within 30.00 s (message time) after 289 iterations";
   EXPECT_EQ(failure_reason(r, 1), "ABORTED in SERVO_STRIPE: stripe servo ended TIMEOUT: no convergence");
   r.end = "DONE";
   r.message.clear();
@@ -114,9 +122,10 @@ TEST(FullCycleMetrics, JsonCarriesTheRequiredKeys) {
   EvalMetrics m;
   accumulate(done_scene(3), 0, MetricTolerances{}, &m);
   const std::string j = metrics_json(m, "bookgrasp_eval_full --scenes 1 --seed 3 --out x");
-  for (const char* key : {"\"scenes\": 1", "\"grasp_attempts\": 3", "\"grasp_success_rate\": 0.666667",
-                          "\"books_moved_rate\": 1", "\"p1_p2_agreement_rate\": 0.5", "\"width_within_1cm_rate\": 0.5",
-                          "\"width_error_mm\": {\"n\": 2, \"mean\": 9", "\"max\": 15", "\"cycle_s\": {\"n\": 2, \"mean\": 110, \"median\": 110",
-                          "\"failures\": [", "{\"seed\": 3, \"reason\": \"GRASP_RETRIED"})
+  for (const char* key :
+       {"\"scenes\": 1", "\"grasp_attempts\": 3", "\"grasp_success_rate\": 0.666667", "\"books_moved_rate\": 1",
+        "\"p1_p2_agreement_rate\": 0.5", "\"width_within_1cm_rate\": 0.5", "\"width_error_mm\": {\"n\": 2, \"mean\": 9",
+        "\"max\": 15", "\"cycle_s\": {\"n\": 2, \"mean\": 110, \"median\": 110", "\"failures\": [",
+        "{\"seed\": 3, \"reason\": \"GRASP_RETRIED"})
     EXPECT_NE(j.find(key), std::string::npos) << key << " missing in\n" << j;
 }
