@@ -35,6 +35,8 @@ StripeServoStep StripeEndServo::step(const StripeObservation& obs, double stando
     if (obs.end_found && armed) {
       // Searching towards +y (right) from the left of the books, the wanted end comes in from the right.
       accept = !p_.require_occlusion || p_.search_direction < 0 || obs.end_px.x() >= ut - 1.0;
+      if (p_.require_occlusion && std::abs(obs.line_end_px.x() - obs.line_start_px.x()) < p_.occlusion_min_segment_px)
+        accept = false;
     }
     if (accept) {
       phase_ = StripePhase::kTrack;

@@ -40,18 +40,21 @@ struct StripeEndServoParams {
   double max_linear_speed = 0.05;  ///< m/s while tracking
   double search_speed = 0.1;       ///< m/s along the stripe while searching
   int search_direction = +1;  ///< while the stripe is hidden: +1 = gripper +y (right as seen from the robot), -1 = left
-  int end_side_direction = -1;         ///< where the end lies from a visible segment whose end is outside the image
-                                       ///< (BSwH end_side: left = -1, right = +1)
-  bool require_occlusion = true;       ///< accept an end only after the stripe was hidden at the target column
-  double converged_x_m = 0.0015;       ///< |error up| below this ...
-  double converged_y_m = 0.0015;       ///< ... and |error right| below this ...
-  int converged_frames = 3;            ///< ... on this many consecutive measurements
-  double max_search_distance_m = 1.0;  ///< give up the search after this much travel
-  double min_track_speed = 0.0;        ///< TRACK: an axis outside its tolerance moves at least this fast (m/s), so
-                                       ///< the arm does not stall just outside the tolerance (0 = pure P law)
-  int track_lost_frames = 0;           ///< TRACK: the end missing on this many consecutive observations -> back to
-                                       ///< SEARCH (an end seen through a gap between books disappears as the
-                                       ///< camera moves); 0 = never (the session reports FEATURE_LOST)
+  int end_side_direction = -1;            ///< where the end lies from a visible segment whose end is outside the image
+                                          ///< (BSwH end_side: left = -1, right = +1)
+  bool require_occlusion = true;          ///< accept an end only after the stripe was hidden at the target column
+  double converged_x_m = 0.0015;          ///< |error up| below this ...
+  double converged_y_m = 0.0015;          ///< ... and |error right| below this ...
+  int converged_frames = 3;               ///< ... on this many consecutive measurements
+  double max_search_distance_m = 1.0;     ///< give up the search after this much travel
+  double min_track_speed = 0.0;           ///< TRACK: an axis outside its tolerance moves at least this fast (m/s), so
+                                          ///< the arm does not stall just outside the tolerance (0 = pure P law)
+  double occlusion_min_segment_px = 0.0;  ///< with require_occlusion: an end is accepted only on a visible segment at
+                                          ///< least this long (shorter ones are the stripe seen through gaps between
+                                          ///< books on the way past them)
+  int track_lost_frames = 0;              ///< TRACK: the end missing on this many consecutive observations -> back to
+                                          ///< SEARCH (an end seen through a gap between books disappears as the
+                                          ///< camera moves); 0 = never (the session reports FEATURE_LOST)
 };
 
 /// What BSwH saw in one image (the fields of stripe_features_t the servo uses).

@@ -76,6 +76,8 @@ VisualServoSettings VisualServoSettings::from_config(const Config& root) {
   s.stripe.converged_frames = st.get_int("converged_frames", 1, 1000);
   s.stripe.max_search_distance_m = st.get_double("max_search_distance_m", 0.01, 10);
   if (st.has("min_track_speed")) s.stripe.min_track_speed = st.get_double("min_track_speed", 0.0, 0.1);
+  if (st.has("occlusion_min_segment_px"))
+    s.stripe.occlusion_min_segment_px = st.get_double("occlusion_min_segment_px", 0.0, 10000.0);
   if (st.has("track_lost_frames")) s.stripe.track_lost_frames = st.get_int("track_lost_frames", 0, 1000);
   return s;
 }

@@ -170,6 +170,21 @@ TEST(StripeEndServo, AnEndThatVanishesWhileTrackingSendsTheSearchOn) {
   }
 }
 
+TEST(StripeEndServo, WithOcclusionRuleShortSegmentsThroughGapsAreNotAccepted) {
+  const HandEyeGeometry g = test::project_geometry();
+  StripeEndServoParams p = params();
+  p.occlusion_min_segment_px = 40;
+  StripeEndServo servo(g, p);
+  servo.step(StripeObservation{}, 0.5, 0.0);  // hidden: occlusion seen
+  StripeObservation gap;
+  gap.found = gap.end_found = true;
+  gap.end_px = gap.line_start_px = {420, 300};
+  gap.line_end_px = {445, 300};  // 25 px: the stripe seen between two books
+  EXPECT_EQ(servo.step(gap, 0.5, 0.01).phase, StripePhase::kSearch);
+  gap.line_end_px = {470, 300};  // 50 px
+  EXPECT_EQ(servo.step(gap, 0.5, 0.02).phase, StripePhase::kTrack);
+}
+
 TEST(StripeEndServo, MinimumTrackSpeedOutsideTheToleranceOnly) {
   const HandEyeGeometry g = test::project_geometry();
   StripeEndServoParams p = params();
