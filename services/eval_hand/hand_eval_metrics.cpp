@@ -276,10 +276,14 @@ cv::Mat per_scene(const std::string& title, const std::vector<double>& xs, const
   };
   series(xs, kRed, -1);
   series(ys, kBlue, 1);
-  text(img, "X (up)", cv::Point(f.W - 250, 24), 0.45, kRed);
-  text(img, "Y (right)", cv::Point(f.W - 180, 24), 0.45, kBlue);
-  text(img, "bands: +-" + fmt("%.0f", tol_x) + " (X), +-" + fmt("%.0f", tol_y) + " (Y)", cv::Point(f.W - 250, f.H - 8),
-       0.4);
+  if (ys.empty()) {
+    text(img, "band: +-" + fmt("%.0f", tol_x), cv::Point(f.W - 250, f.H - 8), 0.4);
+  } else {
+    text(img, "X (up)", cv::Point(f.W - 250, 24), 0.45, kRed);
+    text(img, "Y (right)", cv::Point(f.W - 180, 24), 0.45, kBlue);
+    text(img, "bands: +-" + fmt("%.0f", tol_x) + " (X), +-" + fmt("%.0f", tol_y) + " (Y)",
+         cv::Point(f.W - 250, f.H - 8), 0.4);
+  }
   return img;
 }
 
