@@ -9,19 +9,11 @@ OUT="$1"; SECONDS_TO_RECORD="${2:-3}"
 TMP=$(mktemp -d)
 export BOOKGRASP_RUN_DIR="$TMP/run"
 export BOOKGRASP_LCM_URL="udpm://239.255.76.67:7611?ttl=0&recv_buf_size=4194304"
-export BOOKGRASP_PROCESSES="$TMP/processes.txt"
 cleanup() { "$ROOT/deploy/bookgrasp" stop >/dev/null 2>&1 || true; rm -rf "$TMP"; }
 trap cleanup EXIT
-# The same processes; camera configurations switched to JPEG in temporary copies.
-while read -r name binary config extra; do
-  case "$name" in \#*|"") continue ;; esac
-  if [[ "$name" == *camera ]]; then
-    sed 's/^image_encoding: raw/image_encoding: jpeg/' "$ROOT/$config" > "$TMP/$name.yaml"
-    config="$TMP/$name.yaml"
-  fi
-  echo "$name $binary ${config#$ROOT/} $extra"
-done < "$ROOT/deploy/processes.txt" > "$BOOKGRASP_PROCESSES"
-names=$(grep -vw standby "$BOOKGRASP_PROCESSES" | awk '{print $1}' | paste -sd, -)
+# The same processes (deploy/processes.txt), the cameras publishing JPEG (a --set override).
+export BOOKGRASP_SET="${BOOKGRASP_SET:-} stereo_camera:image_encoding=jpeg hand_camera:image_encoding=jpeg"
+names=$(grep -v '^\s*#' "$ROOT/deploy/processes.txt" | sed '/^\s*$/d' | grep -vw standby | awk '{print $1}' | paste -sd, -)
 # The logger starts first, so the recording holds every input from the system's start: a replay then
 # sees exactly what the live processes saw (no state from before the log).
 rm -f "$OUT"

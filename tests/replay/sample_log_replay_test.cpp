@@ -45,8 +45,9 @@ TEST_P(SampleReplay, ShippedConfigReproducesTheRecordingBitForBit) {
   }
 }
 
-INSTANTIATE_TEST_SUITE_P(Detectors, SampleReplay,
-                         testing::Values("marker_detector", "bws_detector", "bwh_detector", "bswh_detector"));
+INSTANTIATE_TEST_SUITE_P(Services, SampleReplay,
+                         testing::Values("marker_detector", "bws_detector", "bwh_detector", "bswh_detector",
+                                         "arbiter"));
 
 TEST(SampleReplay, ChangedParameterIsReported) {
   // bswh_detector with a different stripe threshold: the stripe outputs move and the report says where.
