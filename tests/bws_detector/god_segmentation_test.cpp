@@ -8,7 +8,7 @@
 
 #include <gtest/gtest.h>
 
-#include "services/bws_detector/hoover_metric.h"
+#include "services/eval_segmentation/hoover_comparison.h"
 #include "synthetic_shelf.h"
 
 namespace bookgrasp::bws {
@@ -264,10 +264,10 @@ TEST(SegmentGod, ShelfSceneSegmentsAgainstGroundTruthFaces) {
   for (int y = 0; y < gt.rows; ++y)
     for (int x = 0; x < gt.cols; ++x)
       if (size[gt.at<int>(y, x)] < 200) gt.at<int>(y, x) = 0;
-  const HooverScore s = hoover_compare(gt, r.labels, 0.8);
+  const eval_segmentation::HooverResult s = eval_segmentation::hoover_compare(gt, r.labels, 0.8);
   std::printf("GoD on exact shelf disparity, T=0.8: %d GT regions, correct %d, over %d, under %d, missed %d, noise %d\n",
-              s.gt_regions, s.correct, s.over, s.under, s.missed, s.noise);
-  EXPECT_GE(double(s.correct) / s.gt_regions, 0.6);
+              s.num_gt(), s.correct, s.over, s.under, s.missed, s.noise);
+  EXPECT_GE(double(s.correct) / s.num_gt(), 0.6);
   // Every book front (face -x of every book box) is a correct detection on its own at T = 0.8.
   for (int b = scene.first_book; b < scene.first_book + scene.num_books; ++b) {
     const int face = b * 6 + test::kFaceMinusX + 1;

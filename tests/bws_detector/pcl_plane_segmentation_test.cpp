@@ -10,7 +10,7 @@
 #include "services/bws_detector/baseline_segmentation.h"
 #include "services/bws_detector/disparity.h"
 #include "services/bws_detector/god_segmentation.h"
-#include "services/bws_detector/hoover_metric.h"
+#include "services/eval_segmentation/hoover_comparison.h"
 #include "synthetic_shelf.h"
 
 namespace bookgrasp::bws {
@@ -95,19 +95,19 @@ TEST(SegmentationComparison, HooverOnTheShelfSceneGodPclAndBaseline) {
   jp.min_region_px = 30;
   const SegmentationResult jump = segment_jump_components(disp, pts, jp);
 
-  std::map<std::string, std::map<double, HooverScore>> table;
+  std::map<std::string, std::map<double, eval_segmentation::HooverResult>> table;
   for (double T : {0.51, 0.6, 0.7, 0.8, 0.9}) {
-    table["god"][T] = hoover_compare(gt, god.labels, T);
-    table["pcl"][T] = hoover_compare(gt, pcl.labels, T);
-    table["jump_components"][T] = hoover_compare(gt, jump.labels, T);
+    table["god"][T] = eval_segmentation::hoover_compare(gt, god.labels, T);
+    table["pcl"][T] = eval_segmentation::hoover_compare(gt, pcl.labels, T);
+    table["jump_components"][T] = eval_segmentation::hoover_compare(gt, jump.labels, T);
   }
   for (const auto& [name, rows] : table)
     for (const auto& [T, s] : rows)
       std::printf("%-16s T=%.2f  GT %d: correct %d, over %d, under %d, missed %d, noise %d\n", name.c_str(), T,
-                  s.gt_regions, s.correct, s.over, s.under, s.missed, s.noise);
+                  s.num_gt(), s.correct, s.over, s.under, s.missed, s.noise);
   // Jump components cannot split creases (a book's top from its front): it must do worse than GoD.
   EXPECT_GT(table["god"][0.8].correct, table["jump_components"][0.8].correct);
-  EXPECT_GE(double(table["god"][0.8].correct) / table["god"][0.8].gt_regions, 0.6);
+  EXPECT_GE(double(table["god"][0.8].correct) / table["god"][0.8].num_gt(), 0.6);
   EXPECT_GT(table["pcl"][0.8].correct, 0);
 }
 
