@@ -1,7 +1,5 @@
 #include "common/process_main.h"
 
-#include <csignal>
-#include <cstring>
 #include <fstream>
 #include <iostream>
 #include <sstream>
@@ -9,18 +7,17 @@
 #include "common/config_overrides.h"
 #include "common/lcm_url.h"
 #include "common/service_host.h"
+#include "common/stop_signal.h"
 #include "common/time_source.h"
 #include "common/version.h"
 
 namespace bookgrasp {
 namespace {
 
-volatile std::sig_atomic_t g_stop = 0;
-void on_signal(int) { g_stop = 1; }
-
 void print_help(const ServiceDescription& d) {
   std::cout << d.name << " - " << d.summary << "\n\n"
-            << "usage: " << d.name << " [--config FILE] [--set KEY=VALUE]... [--lcm-url URL] [--check-config] [--help]\n\n"
+            << "usage: " << d.name
+            << " [--config FILE] [--set KEY=VALUE]... [--lcm-url URL] [--check-config] [--help]\n\n"
             << "  --config FILE   YAML configuration (default: " << kSourceDir << "/" << d.default_config << ")\n"
             << "  --set KEY=VALUE override one value of the configuration file (dotted key, YAML value),\n"
             << "                  e.g. --set user.auto_done_after_s=5; only keys of the file can be set\n"
@@ -75,7 +72,8 @@ int run_service_main(int argc, char** argv, const ServiceDescription& d) {
   std::unique_ptr<ServiceHost> host;
   try {
     std::ifstream probe(config_path);
-    if (!probe) throw ConfigError("config file '" + config_path + "' cannot be read: check the path given with --config");
+    if (!probe)
+      throw ConfigError("config file '" + config_path + "' cannot be read: check the path given with --config");
     const std::string text = apply_config_overrides(read_file(config_path), overrides, config_path);
     const Config root = Config::from_string(text, config_path);
     ServiceSettings settings = ServiceSettings::from_config(root);
@@ -99,22 +97,18 @@ int run_service_main(int argc, char** argv, const ServiceDescription& d) {
     return 3;
   }
 
-  struct sigaction sa;
-  std::memset(&sa, 0, sizeof(sa));
-  sa.sa_handler = on_signal;
-  sigaction(SIGINT, &sa, nullptr);
-  sigaction(SIGTERM, &sa, nullptr);
+  bookgrasp::install_stop_signals();
 
   WallTimeSource clock;
   host->attach(&lcm, [&clock] { return clock.now_utime(); });
   std::cerr << d.name << ": running '" << host->settings().name << "' (" << host->component().implementation()
             << ") on " << url << "\n";
-  while (!g_stop) {
+  while (!bookgrasp::stop_requested()) {
     const int64_t now = clock.now_utime();
     host->poll(now);
     const int64_t wait_us = std::min<int64_t>(host->until_next_due(clock.now_utime()), 100000);
     const int r = lcm.handleTimeout(static_cast<int>(std::max<int64_t>(1, wait_us / 1000)));
-    if (r < 0 && !g_stop) {
+    if (r < 0 && !bookgrasp::stop_requested()) {
       host->component().report_error("LCM handle failed");
     }
   }

@@ -1,7 +1,5 @@
 // bookgrasp_echo: prints the messages of a channel, decoded (any bookgrasp type), or waits for one
 // that satisfies a condition. For people at a terminal and for scripted tests of the running system.
-#include <csignal>
-#include <cstring>
 #include <iostream>
 #include <sstream>
 
@@ -9,15 +7,11 @@
 
 #include "bookgrasp/introspect.hpp"
 #include "common/lcm_url.h"
+#include "common/stop_signal.h"
 #include "common/time_source.h"
 #include "services/channel_echo/field_condition.h"
 
 namespace {
-
-volatile std::sig_atomic_t g_stop = 0;
-void on_signal(int) {
-  g_stop = 1;
-}
 
 void help() {
   std::cout << "bookgrasp_echo - print the decoded messages of a channel, or wait for one\n\n"
@@ -114,17 +108,14 @@ int main(int argc, char** argv) {
     std::cerr << "bookgrasp_echo: cannot open the bus: run `deploy/bookgrasp setup`\n";
     return 3;
   }
-  struct sigaction sa;
-  std::memset(&sa, 0, sizeof(sa));
-  sa.sa_handler = on_signal;
-  sigaction(SIGINT, &sa, nullptr);
-  sigaction(SIGTERM, &sa, nullptr);
+  bookgrasp::install_stop_signals();
   lcm.subscribe(channel, &Echo::on, &echo);
   const bookgrasp::WallTimeSource wall;
   const int64_t until = timeout_s > 0 ? wall.now_utime() + static_cast<int64_t>(timeout_s * 1e6) : INT64_MAX;
-  while (!g_stop && !echo.done && wall.now_utime() < until) lcm.handleTimeout(50);
+  while (!bookgrasp::stop_requested() && !echo.done && wall.now_utime() < until) lcm.handleTimeout(50);
   if (echo.done) return 0;
-  std::cerr << "bookgrasp_echo: " << (g_stop ? "interrupted" : "timed out") << " after " << echo.seen
-            << " message(s) on " << channel << (echo.has_until ? " without the --until condition" : "") << "\n";
+  std::cerr << "bookgrasp_echo: " << (bookgrasp::stop_requested() ? "interrupted" : "timed out") << " after "
+            << echo.seen << " message(s) on " << channel << (echo.has_until ? " without the --until condition" : "")
+            << "\n";
   return 1;
 }

@@ -1,19 +1,15 @@
 // bookgrasp_monitor: a top-like view of every service's SERVICE_STATUS.
-#include <csignal>
-#include <cstring>
 #include <iostream>
 #include <sstream>
 
 #include <lcm/lcm-cpp.hpp>
 
 #include "common/lcm_url.h"
+#include "common/stop_signal.h"
 #include "common/time_source.h"
 #include "services/monitor/service_table.h"
 
 namespace {
-
-volatile std::sig_atomic_t g_stop = 0;
-void on_signal(int) { g_stop = 1; }
 
 struct Listener {
   bookgrasp::ServiceTable table;
@@ -55,11 +51,16 @@ int main(int argc, char** argv) {
       if (a == "--help" || a == "-h") {
         help();
         return 0;
-      } else if (a == "--lcm-url") url_arg = value();
-      else if (a == "--channel") channel = value();
-      else if (a == "--timeout") timeout_s = std::stod(value());
-      else if (a == "--seconds") seconds = std::stod(value());
-      else if (a == "--once") once = true;
+      } else if (a == "--lcm-url")
+        url_arg = value();
+      else if (a == "--channel")
+        channel = value();
+      else if (a == "--timeout")
+        timeout_s = std::stod(value());
+      else if (a == "--seconds")
+        seconds = std::stod(value());
+      else if (a == "--once")
+        once = true;
       else if (a == "--expect") {
         std::stringstream ss(value());
         std::string name;
@@ -80,18 +81,18 @@ int main(int argc, char** argv) {
     std::cerr << "bookgrasp_monitor: cannot open " << url << ": run `deploy/bookgrasp setup`\n";
     return 3;
   }
-  std::signal(SIGINT, on_signal);
-  std::signal(SIGTERM, on_signal);
+  bookgrasp::install_stop_signals();
   Listener l;
   lcm.subscribe(channel, &Listener::on_status, &l);
   const int64_t start = l.clock.now_utime();
   auto elapsed = [&] { return (l.clock.now_utime() - start) * 1e-6; };
 
   if (!expect.empty()) {
-    while (!g_stop && elapsed() < timeout_s && !l.table.missing(expect).empty()) lcm.handleTimeout(50);
+    while (!bookgrasp::stop_requested() && elapsed() < timeout_s && !l.table.missing(expect).empty())
+      lcm.handleTimeout(50);
     // One more second so every service has reported its rates.
     const double until = elapsed() + 1.2;
-    while (!g_stop && elapsed() < until) lcm.handleTimeout(50);
+    while (!bookgrasp::stop_requested() && elapsed() < until) lcm.handleTimeout(50);
     std::cout << l.table.render(l.clock.now_utime());
     const auto missing = l.table.missing(expect);
     if (missing.empty()) {
@@ -104,16 +105,17 @@ int main(int argc, char** argv) {
     return 1;
   }
   if (once) {
-    while (!g_stop && elapsed() < seconds) lcm.handleTimeout(50);
+    while (!bookgrasp::stop_requested() && elapsed() < seconds) lcm.handleTimeout(50);
     std::cout << l.table.render(l.clock.now_utime());
     return 0;
   }
   int64_t next = 0;
-  while (!g_stop) {
+  while (!bookgrasp::stop_requested()) {
     lcm.handleTimeout(50);
     const int64_t now = l.clock.now_utime();
     if (now >= next) {
-      std::cout << "\033[2J\033[H" << "bookgrasp monitor on " << url << "  (Ctrl-C to quit)\n\n"
+      std::cout << "\033[2J\033[H"
+                << "bookgrasp monitor on " << url << "  (Ctrl-C to quit)\n\n"
                 << l.table.render(now) << std::flush;
       next = now + 1000000;
     }

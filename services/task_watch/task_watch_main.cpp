@@ -1,21 +1,15 @@
 // bookgrasp_task: follows the library task on the bus (TASK_STATUS), prints its progress and, when it
 // ends, a summary: books moved, failures with reasons, cycle times. Used by `deploy/bookgrasp demo`.
-#include <csignal>
-#include <cstring>
 #include <iostream>
 
 #include <lcm/lcm-cpp.hpp>
 
 #include "common/lcm_url.h"
+#include "common/stop_signal.h"
 #include "common/time_source.h"
 #include "services/task_watch/task_run_log.h"
 
 namespace {
-
-volatile std::sig_atomic_t g_stop = 0;
-void on_signal(int) {
-  g_stop = 1;
-}
 
 void help() {
   std::cout << "bookgrasp_task - follow the library task (TASK_STATUS) and summarise it\n\n"
@@ -82,18 +76,14 @@ int main(int argc, char** argv) {
     std::cerr << "bookgrasp_task: cannot open the bus: run `deploy/bookgrasp setup`\n";
     return 3;
   }
-  struct sigaction sa;
-  std::memset(&sa, 0, sizeof(sa));
-  sa.sa_handler = on_signal;
-  sigaction(SIGINT, &sa, nullptr);
-  sigaction(SIGTERM, &sa, nullptr);
+  bookgrasp::install_stop_signals();
 
   Listener listener(books);
   lcm.subscribe(channel, &Listener::on, &listener);
   // Wall time only bounds how long a person waits; the task's own times are message time.
   const bookgrasp::WallTimeSource wall;
   const int64_t until = timeout_s > 0 ? wall.now_utime() + static_cast<int64_t>(timeout_s * 1e6) : INT64_MAX;
-  while (!g_stop && listener.log.end() == bookgrasp::TaskEnd::kRunning && wall.now_utime() < until)
+  while (!bookgrasp::stop_requested() && listener.log.end() == bookgrasp::TaskEnd::kRunning && wall.now_utime() < until)
     lcm.handleTimeout(100);
 
   std::cout << "\n" << listener.log.summary();
@@ -110,6 +100,6 @@ int main(int argc, char** argv) {
     case bookgrasp::TaskEnd::kRunning:
       break;
   }
-  std::cout << (g_stop ? "interrupted" : "timed out") << " while the task was running\n";
+  std::cout << (bookgrasp::stop_requested() ? "interrupted" : "timed out") << " while the task was running\n";
   return 4;
 }
