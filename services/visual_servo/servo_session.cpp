@@ -6,7 +6,9 @@
 namespace bookgrasp {
 
 namespace {
-int64_t seconds_to_us(double s) { return static_cast<int64_t>(std::llround(s * 1e6)); }
+int64_t seconds_to_us(double s) {
+  return static_cast<int64_t>(std::llround(s * 1e6));
+}
 std::string fmt(const char* f, double a, double b = 0, double c = 0) {
   char buf[256];
   std::snprintf(buf, sizeof(buf), f, a, b, c);
@@ -16,13 +18,20 @@ std::string fmt(const char* f, double a, double b = 0, double c = 0) {
 
 std::string servo_state_name(ServoState s) {
   switch (s) {
-    case ServoState::kIdle: return "IDLE";
-    case ServoState::kRunning: return "RUNNING";
-    case ServoState::kConverged: return "CONVERGED";
-    case ServoState::kFeatureLost: return "FEATURE_LOST";
-    case ServoState::kTimeout: return "TIMEOUT";
-    case ServoState::kFailed: return "FAILED";
-    case ServoState::kCancelled: return "CANCELLED";
+    case ServoState::kIdle:
+      return "IDLE";
+    case ServoState::kRunning:
+      return "RUNNING";
+    case ServoState::kConverged:
+      return "CONVERGED";
+    case ServoState::kFeatureLost:
+      return "FEATURE_LOST";
+    case ServoState::kTimeout:
+      return "TIMEOUT";
+    case ServoState::kFailed:
+      return "FAILED";
+    case ServoState::kCancelled:
+      return "CANCELLED";
   }
   return "?";
 }
@@ -81,14 +90,23 @@ void ServoSession::advance(int64_t utime, SessionOutput* out) {
   if (!running_) return;
   if (now_ >= deadline_utime_) {
     finish(ServoState::kTimeout,
-           fmt("no convergence within %.2f s (message time) after %.0f iterations", (deadline_utime_ - start_utime_) * 1e-6,
-               iterations_),
+           fmt("no convergence within %.2f s (message time) after %.0f iterations",
+               (deadline_utime_ - start_utime_) * 1e-6, iterations_),
            out);
     return;
   }
+  // Times since the last good measurement ARRIVED (message time), not since its image was taken: the
+  // camera -> detector pipeline of separate processes has a latency (0.05-0.25 s on a quiet machine,
+  // ~0.7 s when it is loaded) that the control law compensates with the pose at capture time. Until
+  // the first image taken after the start has arrived, the pose history's length is allowed on top.
   const double since_good = (now_ - last_good_utime_) * 1e-6;
-  if (now_ - last_good_utime_ > seconds_to_us(p_.feature_lost_timeout_s)) {
-    std::string why = last_lost_reason_.empty() ? "no feature measurement arrived" : last_lost_reason_;
+  const double lost_limit_s = p_.feature_lost_timeout_s + (measured_since_start_ ? 0.0 : p_.pose_history_s);
+  if (now_ - last_good_utime_ > seconds_to_us(lost_limit_s)) {
+    std::string why = last_lost_reason_.empty()
+                          ? fmt("no feature measurement of an image taken after the start arrived within %.2f s "
+                                "(camera or detector down or too slow?)",
+                                lost_limit_s)
+                          : last_lost_reason_;
     finish(ServoState::kFeatureLost,
            fmt("feature lost for %.2f s (feature_lost_timeout_s %.2f): ", since_good, p_.feature_lost_timeout_s) + why,
            out);
@@ -100,7 +118,8 @@ void ServoSession::advance(int64_t utime, SessionOutput* out) {
     command(GripperTwist::Zero(), out);
     return;
   }
-  if (last_command_utime_ == INT64_MIN || now_ - last_command_utime_ >= seconds_to_us(p_.command_period_s)) command(stale ? GripperTwist::Zero() : twist_, out);
+  if (last_command_utime_ == INT64_MIN || now_ - last_command_utime_ >= seconds_to_us(p_.command_period_s))
+    command(stale ? GripperTwist::Zero() : twist_, out);
 }
 
 SessionOutput ServoSession::on_request(const ServoRequest& request) {
@@ -146,6 +165,7 @@ SessionOutput ServoSession::on_request(const ServoRequest& request) {
   deadline_utime_ = now_ + seconds_to_us(request.timeout_s > 0 ? request.timeout_s : p_.default_timeout_s);
   last_good_utime_ = now_;
   last_measurement_utime_ = now_;
+  measured_since_start_ = false;
   last_command_utime_ = INT64_MIN;
   arm_executing_seen_ = false;
   holding_ = false;
@@ -170,8 +190,7 @@ SessionOutput ServoSession::on_arm_state(int64_t utime, const Eigen::Isometry3d&
   if (utime > now_) now_ = utime;
   if (running_) {
     if (condition == ArmCondition::kExecuting && last_command_utime_ != INT64_MIN) arm_executing_seen_ = true;
-    if (condition == ArmCondition::kFault ||
-        (condition == ArmCondition::kStopped && arm_executing_seen_)) {
+    if (condition == ArmCondition::kFault || (condition == ArmCondition::kStopped && arm_executing_seen_)) {
       finish(ServoState::kFailed, "the arm driver stopped: " + arm_message, &out);
       return out;
     }
@@ -182,9 +201,10 @@ SessionOutput ServoSession::on_arm_state(int64_t utime, const Eigen::Isometry3d&
 
 bool ServoSession::accept_measurement_time(int64_t utime) {
   if (!running_) return false;
-  if (utime < start_utime_) return false;              // image taken before the task started
+  if (utime < start_utime_) return false;                                 // image taken before the task started
   if (utime <= last_measurement_utime_ && iterations_ > 0) return false;  // repeated / out of order
   last_measurement_utime_ = utime;
+  measured_since_start_ = true;
   return true;
 }
 
@@ -203,11 +223,11 @@ SessionOutput ServoSession::on_book(const BookObservation& obs) {
   ++iterations_;
   error_px_ = s.error_px;
   slope_error_ = s.slope_error_rad;
-  last_good_utime_ = std::max(last_good_utime_, obs.utime);
+  last_good_utime_ = now_;  // arrival (message time), see advance()
   holding_ = false;
   if (s.converged) {
-    finish(ServoState::kConverged, fmt("R within %.2f px of the target (%.1f, %.1f)", s.error_px.norm(),
-                                       s.target_px.x(), s.target_px.y()),
+    finish(ServoState::kConverged,
+           fmt("R within %.2f px of the target (%.1f, %.1f)", s.error_px.norm(), s.target_px.x(), s.target_px.y()),
            &out, pose_at(obs.utime));
     return out;
   }
@@ -235,12 +255,12 @@ SessionOutput ServoSession::on_stripe(int64_t utime, const StripeObservation& ob
   ++iterations_;
   error_px_ = s.error_px;
   slope_error_ = 0;
-  last_good_utime_ = std::max(last_good_utime_, utime);
+  last_good_utime_ = now_;  // arrival (message time), see advance()
   holding_ = false;
   if (s.converged) {
-    finish(ServoState::kConverged, fmt("stripe end within (%.1f, %.1f) mm of the TCP axis", s.error_m.x() * 1e3,
-                                       s.error_m.y() * 1e3),
-           &out, pose_at(utime));
+    finish(ServoState::kConverged,
+           fmt("stripe end within (%.1f, %.1f) mm of the TCP axis", s.error_m.x() * 1e3, s.error_m.y() * 1e3), &out,
+           pose_at(utime));
     return out;
   }
   command(s.twist, &out);

@@ -33,21 +33,29 @@ namespace bookgrasp {
 /// Task kinds (numbers as servo_request_t modes).
 enum class ServoMode { kCancel = 0, kBookCorner = 1, kStripeEnd = 2 };
 /// Task states (numbers as servo_status_t states).
-enum class ServoState { kIdle = 0, kRunning = 1, kConverged = 2, kFeatureLost = 3, kTimeout = 4, kFailed = 5, kCancelled = 6 };
+enum class ServoState {
+  kIdle = 0,
+  kRunning = 1,
+  kConverged = 2,
+  kFeatureLost = 3,
+  kTimeout = 4,
+  kFailed = 5,
+  kCancelled = 6
+};
 
 /// Name of a state ("IDLE", "RUNNING", ...).
 std::string servo_state_name(ServoState s);
 
 /// Timing and start checks of a task (from configuration).
 struct ServoSessionParams {
-  double feature_lost_timeout_s = 0.6;    ///< no usable measurement this long -> STOP, FEATURE_LOST
-  double stale_feature_s = 0.25;          ///< no usable measurement this long -> zero velocity
-  double command_period_s = 0.05;         ///< repeat the command at least this often
-  double default_timeout_s = 20.0;        ///< when the request gives timeout_s <= 0
-  double max_start_error_m = 0.02;        ///< TCP this far from the request's start_pose -> FAILED
-  double default_corner_standoff_m = 0.2; ///< TCP to book front when the request gives fixed_depth_m <= 0
-  double default_stripe_standoff_m = 0.5; ///< TCP to rear board when the request gives fixed_depth_m <= 0
-  double pose_history_s = 1.0;            ///< end-effector poses kept to look up the pose at capture time
+  double feature_lost_timeout_s = 0.6;     ///< no usable measurement this long -> STOP, FEATURE_LOST
+  double stale_feature_s = 0.25;           ///< no usable measurement this long -> zero velocity
+  double command_period_s = 0.05;          ///< repeat the command at least this often
+  double default_timeout_s = 20.0;         ///< when the request gives timeout_s <= 0
+  double max_start_error_m = 0.02;         ///< TCP this far from the request's start_pose -> FAILED
+  double default_corner_standoff_m = 0.2;  ///< TCP to book front when the request gives fixed_depth_m <= 0
+  double default_stripe_standoff_m = 0.5;  ///< TCP to rear board when the request gives fixed_depth_m <= 0
+  double pose_history_s = 1.0;             ///< end-effector poses kept to look up the pose at capture time
 };
 
 /// A start/cancel request (servo_request_t without LCM).
@@ -56,9 +64,9 @@ struct ServoRequest {
   int64_t request_id = 0;
   ServoMode mode = ServoMode::kCancel;
   std::optional<Eigen::Isometry3d> start_pose;  ///< checked against the arm if given
-  double standoff_m = 0;        ///< fixed_depth_m: TCP to the observed plane (<= 0: configured default)
-  int rank_from_right = 0;      ///< BwH rank the features must carry
-  double timeout_s = 0;         ///< <= 0: configured default
+  double standoff_m = 0;                        ///< fixed_depth_m: TCP to the observed plane (<= 0: configured default)
+  int rank_from_right = 0;                      ///< BwH rank the features must carry
+  double timeout_s = 0;                         ///< <= 0: configured default
 };
 
 /// A BwH measurement (book_features_hand_t fields the servo uses).
@@ -152,7 +160,8 @@ class ServoSession {
   double standoff_ = 0;
   int64_t start_utime_ = 0;
   int64_t deadline_utime_ = 0;
-  int64_t last_good_utime_ = 0;
+  int64_t last_good_utime_ = 0;        ///< message time when the last good measurement arrived
+  bool measured_since_start_ = false;  ///< a measurement of an image taken after the start arrived
   int64_t last_measurement_utime_ = INT64_MIN;
   int64_t last_command_utime_ = INT64_MIN;
   bool arm_executing_seen_ = false;

@@ -2,8 +2,8 @@
 // timeout, start checks, cancel, stale/mismatched measurements, converged pose at capture.
 #include <gtest/gtest.h>
 
-#include "servo_plant.h"
 #include "services/visual_servo/servo_session.h"
+#include "servo_plant.h"
 
 namespace bookgrasp {
 namespace {
@@ -78,7 +78,8 @@ TEST_F(Fixture, FeatureLostStopsTheArmAndSaysWhy) {
   }
   ASSERT_FALSE(session.running());
   EXPECT_EQ(last_report().state, ServoState::kFeatureLost);
-  EXPECT_NE(last_report().message.find("no region passes the book criteria"), std::string::npos) << last_report().message;
+  EXPECT_NE(last_report().message.find("no region passes the book criteria"), std::string::npos)
+      << last_report().message;
   EXPECT_TRUE(commands.back().stop);
   // Stopped just after feature_lost_timeout_s of message time.
   EXPECT_GT(t - last_good, 600'000);
@@ -91,6 +92,49 @@ TEST_F(Fixture, FeatureLostStopsTheArmAndSaysWhy) {
       zero_seen = true;
     }
   EXPECT_TRUE(zero_seen);
+}
+
+TEST_F(Fixture, PipelineLatencyIsNotALostFeature) {
+  // Separate processes: each measurement arrives 0.7 s (more than feature_lost_timeout_s) after its
+  // image was taken, every 0.1 s. The servo keeps running and moving; lost and stale are judged by
+  // arrival. Only when measurements stop arriving does it stop, 0.6 s after the last one arrived.
+  arm(kT0);
+  start_corner(kT0);
+  int64_t t = kT0, last_arrival = 0;
+  for (int i = 1; i <= 400; ++i) {
+    t = kT0 + i * 10'000;
+    arm(t);
+    const int64_t captured = t - 700'000;
+    if (i % 10 == 0 && captured >= kT0 && i <= 250) {
+      take(session.on_book(book(captured, true)));
+      last_arrival = t;
+    }
+    if (i == 240) {
+      ASSERT_TRUE(session.running()) << last_report().message;
+      EXPECT_GT(commands.back().twist.norm(), 0.0) << "holding despite fresh arrivals";
+    }
+    if (!session.running()) break;
+  }
+  ASSERT_FALSE(session.running());
+  EXPECT_EQ(last_report().state, ServoState::kFeatureLost);
+  EXPECT_GT(t - last_arrival, 600'000);
+  EXPECT_LE(t - last_arrival, 610'000);
+}
+
+TEST_F(Fixture, NoMeasurementAfterTheStartIsLostAfterTheTimeoutPlusThePoseHistory) {
+  arm(kT0);
+  start_corner(kT0);
+  int64_t t = kT0;
+  for (int i = 1; i <= 300 && session.running(); ++i) {
+    t = kT0 + i * 10'000;
+    arm(t);
+  }
+  ASSERT_FALSE(session.running());
+  EXPECT_EQ(last_report().state, ServoState::kFeatureLost);
+  EXPECT_NE(last_report().message.find("no feature measurement of an image taken after the start"), std::string::npos)
+      << last_report().message;
+  EXPECT_GT(t - kT0, 1'600'000);  // 0.6 s + pose_history_s 1.0 s
+  EXPECT_LE(t - kT0, 1'610'000);
 }
 
 TEST_F(Fixture, CommandsRepeatAtLeastEveryCommandPeriod) {
@@ -174,7 +218,7 @@ TEST_F(Fixture, ConvergedPoseIsThePoseAtCapture) {
   const Eigen::Vector2d target = geo.target_pixel(0.2);
   for (int i = 1; i <= 30 && session.running(); ++i) {
     const int64_t t = kT0 + i * 10'000;
-    arm(t, 0.001 * i);  // the arm reports a moving TCP
+    arm(t, 0.001 * i);                                                      // the arm reports a moving TCP
     if (i % 10 == 0) take(session.on_book(book(t - 5'000, true, target)));  // image 5 ms old
   }
   ASSERT_EQ(last_report().state, ServoState::kConverged);
