@@ -102,11 +102,16 @@ void ServoSession::advance(int64_t utime, SessionOutput* out) {
   const double since_good = (now_ - last_good_utime_) * 1e-6;
   const double lost_limit_s = p_.feature_lost_timeout_s + (measured_since_start_ ? 0.0 : p_.pose_history_s);
   if (now_ - last_good_utime_ > seconds_to_us(lost_limit_s)) {
-    std::string why = last_lost_reason_.empty()
-                          ? fmt("no feature measurement of an image taken after the start arrived within %.2f s "
-                                "(camera or detector down or too slow?)",
-                                lost_limit_s)
-                          : last_lost_reason_;
+    std::string why;
+    if (!last_lost_reason_.empty())
+      why = last_lost_reason_;
+    else if (measured_since_start_)
+      why = fmt("no feature measurement arrived for %.2f s (camera or detector stalled or too slow?)", since_good);
+    else
+      why =
+          fmt("no feature measurement of an image taken after the start arrived within %.2f s "
+              "(camera or detector down or too slow?)",
+              lost_limit_s);
     finish(ServoState::kFeatureLost,
            fmt("feature lost for %.2f s (feature_lost_timeout_s %.2f): ", since_good, p_.feature_lost_timeout_s) + why,
            out);
