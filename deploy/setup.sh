@@ -14,7 +14,7 @@ sudo_if_needed() { if [ "$(id -u)" -eq 0 ]; then "$@"; else sudo "$@"; fi; }
 mapfile -t WANTED < <(grep -v '^\s*#' "$ROOT/deploy/packages.txt" | tr ' ' '\n' | sed '/^\s*$/d')
 MISSING=()
 for p in "${WANTED[@]}"; do
-  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || MISSING+=("$p")
+  [[ "$(dpkg-query -W -f='${Status}' "$p" 2>/dev/null || true)" == *"install ok installed"* ]] || MISSING+=("$p")
 done
 if [ ${#MISSING[@]} -gt 0 ]; then
   log "installing ${#MISSING[@]} missing Debian packages: ${MISSING[*]}"
@@ -27,7 +27,7 @@ fi
 
 # 2. LCM over UDP multicast on loopback (not persistent across boots: done every time)
 sudo_if_needed ip link set lo multicast on
-if ! ip route show 224.0.0.0/4 | grep -q 'dev lo'; then
+if [[ "$(ip route show 224.0.0.0/4)" != *"dev lo"* ]]; then
   sudo_if_needed ip route add 224.0.0.0/4 dev lo 2>/dev/null || log "warning: could not add the multicast route on lo"
 fi
 log "multicast route: $(ip route show 224.0.0.0/4 | head -1)"

@@ -23,7 +23,7 @@ names=$(grep -v '^\s*#' "$SRC/deploy/processes.txt" | sed '/^\s*$/d' | grep -vw 
 all=$(echo $names | tr ' ' ',')
 "$FRONT" start >/dev/null
 "$MON" --lcm-url "$BOOKGRASP_LCM_URL" --expect "$all" --timeout 90 > "$TMP/table.txt" || fail "not every service came up: $(cat "$TMP/table.txt")"
-if echo "$names" | grep -qw coordinator; then
+if grep -qw coordinator <<< "$names"; then
   # The first book always starts with a planned move to the stripe servo's station A (no PS yet).
   "$ECHO" --lcm-url "$BOOKGRASP_LCM_URL" --channel TASK_STATUS --until state=MOVE_TO_STRIPE_START --quiet \
     --field state --timeout 90 >/dev/null || fail "the coordinator never reached MOVE_TO_STRIPE_START"
@@ -51,7 +51,7 @@ for name in $names; do
   [ "$new" != "$old" ] || fail "$name was not restarted after kill -9"
   # Every service, the restarted one included, reports again.
   "$MON" --lcm-url "$BOOKGRASP_LCM_URL" --expect "$all" --timeout 90 > "$TMP/table.txt" || fail "after killing $name: $(cat "$TMP/table.txt")"
-  grep -E "^$name +" "$TMP/table.txt" | grep -q " $new " || fail "$name: the new pid $new is not the one reporting"
+  grep -qE "^$name +.* $new " "$TMP/table.txt" || fail "$name: the new pid $new is not the one reporting"
   # Nobody rejects input because a neighbour restarted (e.g. a restarted simulation's clock starts over).
   rejecting=$(awk 'NR > 1 && $1 != "all" && $8 ~ /^[0-9]+$/ && $8 > 0 {print $1 " (" $8 ")"}' "$TMP/table.txt")
   [ -z "$rejecting" ] || fail "after killing $name these services reject input: $rejecting

@@ -30,7 +30,7 @@ done
 [ "$pid2" != "$pid1" ] || fail "supervisord did not restart the killed process"
 out=$("$MON" --lcm-url "$BOOKGRASP_LCM_URL" --once --seconds 2)
 echo "$out"
-echo "$out" | grep -q "test_echo" || fail "restarted process not on the bus"
+grep -q "test_echo" <<< "$out" || fail "restarted process not on the bus"
 "$FRONT" stop
 kill -0 "$pid2" 2>/dev/null && fail "process still running after stop"
 echo "PASS: started, restarted after kill -9 (pid $pid1 -> $pid2), stopped"

@@ -9,7 +9,7 @@ listing=$(jar tf "$JAR")
 missing=0
 for f in "$SRC"/lcmtypes/*.lcm; do
   t=$(basename "$f" .lcm)
-  echo "$listing" | grep -qx "bookgrasp/$t.class" || { echo "FAIL: bookgrasp/$t.class not in the jar"; missing=1; }
+  grep -qx "bookgrasp/$t.class" <<< "$listing" || { echo "FAIL: bookgrasp/$t.class not in the jar"; missing=1; }
 done
 [ "$missing" -eq 0 ] || exit 1
 # Load every class and read its fingerprint, as lcm-spy does.
