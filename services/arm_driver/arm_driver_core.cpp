@@ -1,5 +1,6 @@
 #include "services/arm_driver/arm_driver_core.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 
@@ -32,7 +33,13 @@ void ArmDriverCore::on_measurement(int64_t now_utime, const Eigen::VectorXd& q, 
     qd_cmd_ = Eigen::VectorXd::Zero(q.size());
     last_heard_ = now_;
   }
-  if (gripper_width_ < 0) gripper_width_ = gripper_width;
+  if (gripper_width_ < 0) gripper_width_ = hold_width(gripper_width);
+}
+
+double ArmDriverCore::hold_width(double measured) const {
+  // The plates can read a little beyond the stroke (contact, numerical slack): holding that value
+  // would be a setpoint the gripper rejects.
+  return std::clamp(measured, params_.gripper_min_width, params_.gripper_max_width);
 }
 
 void ArmDriverCore::restart(int64_t now_utime, const Eigen::VectorXd& q, double gripper_width) {
@@ -42,7 +49,7 @@ void ArmDriverCore::restart(int64_t now_utime, const Eigen::VectorXd& q, double 
   q_measured_ = q;
   q_cmd_ = q;
   qd_cmd_ = Eigen::VectorXd::Zero(q.size());
-  gripper_width_ = gripper_width;
+  gripper_width_ = hold_width(gripper_width);
   stop("the arm's source restarted (simulation reset): motion stopped, holding the new position");
 }
 

@@ -88,6 +88,8 @@ class ArmDriverCore {
   const ArmLimits& limits() const { return limits_; }
 
  private:
+  /// A measured plate distance as a gripper target: clamped to [gripper_min_width, gripper_max_width].
+  double hold_width(double measured) const;
   enum class Mode { kHold, kTrajectory, kCartesian };
   void stop(const std::string& reason);
 

@@ -10,6 +10,7 @@ namespace {
 
 constexpr int kArmIdle = 0;
 constexpr int kArmExecuting = 1;
+constexpr double kForeignMotionSettleS = 0.3;  ///< still this long after stopping a predecessor's motion
 constexpr int kArmStopped = 2;
 constexpr int kArmFault = 3;
 constexpr int kServoBookCorner = 1;
@@ -790,11 +791,31 @@ std::vector<CycleRequest> LibraryCycle::on_arm(const ArmEvent& e) {
     if (e.state == kArmExecuting) {
       out_.push_back(make_request(CycleRequest::Kind::kArmStop));
       message_ = "stopping the arm's unfinished motion before resuming";
+      stopping_foreign_motion_ = true;
+      last_foreign_stop_utime_ = now_;
+      arm_quiet_since_ = -1;
     }
     enter(CycleState::kWaitMarkers);
   }
+  if (state_ == CycleState::kWaitMarkers && stopping_foreign_motion_) {
+    // The motion may have been a visual servo's: commands already in flight can start the arm again
+    // after the STOP. Go on only once the arm has stayed still for kForeignMotionSettleS; STOP again
+    // (at most every kForeignMotionSettleS) while it moves.
+    if (e.state == kArmExecuting) {
+      arm_quiet_since_ = -1;
+      if (now_ - last_foreign_stop_utime_ >= static_cast<int64_t>(kForeignMotionSettleS * 1e6)) {
+        out_.push_back(make_request(CycleRequest::Kind::kArmStop));
+        last_foreign_stop_utime_ = now_;
+      }
+    } else if (arm_quiet_since_ < 0) {
+      arm_quiet_since_ = now_;
+    }
+  }
+  const bool arm_settled =
+      !stopping_foreign_motion_ ||
+      (arm_quiet_since_ >= 0 && now_ - arm_quiet_since_ >= static_cast<int64_t>(kForeignMotionSettleS * 1e6));
   if (state_ == CycleState::kWaitMarkers) {
-    if (cart_marker_ && holder_marker_ && e.state != kArmExecuting) {
+    if (cart_marker_ && holder_marker_ && e.state != kArmExecuting && arm_settled) {
       const bool holding =
           progress_.place == BookPlace::kInGripperFromShelf || progress_.place == BookPlace::kInGripperFromHolder;
       if (holding && !e.gripper_contact) {

@@ -43,25 +43,25 @@ namespace bookgrasp {
 /// Timeouts, retries and motion parameters of the cycle.
 struct CycleSettings {
   CycleGeometry geometry;
-  std::vector<double> park_joints;        ///< rad; the arm out of the stereo view
+  std::vector<double> park_joints;  ///< rad; the arm out of the stereo view
   // timeouts, seconds of message time
   double markers_timeout_s = 10;
   double decision_timeout_s = 10;
   double servo_timeout_s = 30;
   double plan_timeout_s = 10;
-  double motion_margin_s = 5;             ///< added to a trajectory's or straight move's nominal duration
+  double motion_margin_s = 5;  ///< added to a trajectory's or straight move's nominal duration
   double gripper_timeout_s = 5;
-  double user_timeout_s = 0;              ///< 0 = wait for "done" forever
-  double auto_done_after_s = 0;           ///< >0: send "done" after this long in WAIT_USER (demo)
+  double user_timeout_s = 0;     ///< 0 = wait for "done" forever
+  double auto_done_after_s = 0;  ///< >0: send "done" after this long in WAIT_USER (demo)
   // retries
   int max_attempts_per_book = 3;
   int max_step_retries = 2;
   // planner
-  std::string planner;                    ///< "" = the planner's default
+  std::string planner;  ///< "" = the planner's default
   double plan_time_budget_s = 2;
   double plan_position_tolerance_m = 0.002;
   double plan_orientation_tolerance_rad = 0.02;
-  double held_book_depth_m = 0.25;        ///< depth assumed for a held book (collision model)
+  double held_book_depth_m = 0.25;  ///< depth assumed for a held book (collision model)
   // arm commands
   double heartbeat_period_s = 0.05;       ///< <= 0.1 s: the driver stops after 0.5 s without
   double linear_max_speed = 0.05;         ///< m/s for straight moves
@@ -76,10 +76,10 @@ struct CycleSettings {
   double gripper_force = 60;
   double gripper_settle_s = 0.2;
   double gripper_settle_tolerance = 0.0005;
-  double min_book_width = 0.005;          ///< closed below this = nothing grasped
+  double min_book_width = 0.005;  ///< closed below this = nothing grasped
   // emptiness
   double empty_stripe_margin = 0.02;
-  double s_min = 0.015;                   ///< narrowest admissible book (paper 4.1: L_max/4)
+  double s_min = 0.015;  ///< narrowest admissible book (paper 4.1: L_max/4)
   /// Reads everything but the `service:` and `channels:` sections; throws ConfigError naming a bad key.
   static CycleSettings from_config(const Config& root);
 };
@@ -91,7 +91,7 @@ struct ArmEvent {
   Eigen::Isometry3d end_effector = Eigen::Isometry3d::Identity();  ///< gripper TCP in base
   double gripper_width = 0;
   bool gripper_contact = false;
-  int state = 0;                          ///< arm_state_t IDLE/EXECUTING/STOPPED/FAULT
+  int state = 0;  ///< arm_state_t IDLE/EXECUTING/STOPPED/FAULT
   int64_t active_command_id = 0;
   std::string message;
 };
@@ -107,10 +107,10 @@ struct MarkersEvent {
 struct DecisionEvent {
   int64_t utime = 0;
   int64_t request_id = 0;
-  std::string outcome;                    ///< first word of the reason: P1_VALID, GRASP, NEXT_REGION, ...
-  int next_rank = 0;                      ///< NEXT_REGION
+  std::string outcome;  ///< first word of the reason: P1_VALID, GRASP, NEXT_REGION, ...
+  int next_rank = 0;    ///< NEXT_REGION
   bool valid = false;
-  bool p1_present = false;                ///< p1_grasp finite
+  bool p1_present = false;  ///< p1_grasp finite
   Eigen::Isometry3d gp_base = Eigen::Isometry3d::Identity();
   Eigen::Vector3d gp_grasp = Eigen::Vector3d::Zero();
   bool ps_present = false;
@@ -122,8 +122,8 @@ struct DecisionEvent {
 struct ServoEvent {
   int64_t utime = 0;
   int64_t request_id = 0;
-  int mode = 0;                           ///< servo_request_t mode
-  int state = 0;                          ///< servo_status_t state
+  int mode = 0;   ///< servo_request_t mode
+  int state = 0;  ///< servo_status_t state
   std::string message;
 };
 
@@ -133,7 +133,7 @@ struct PlanEvent {
   int64_t request_id = 0;
   bool success = false;
   std::string message;
-  double duration_s = 0;                  ///< of the trajectory
+  double duration_s = 0;  ///< of the trajectory
 };
 
 /// A user or operator event ("done", "abort").
@@ -158,7 +158,7 @@ struct CycleRequest {
     kUserEvent,     ///< USER_EVENT (the demo's own "done")
   };
   Kind kind = Kind::kHeartbeat;
-  int64_t id = 0;                         ///< request / command id
+  int64_t id = 0;  ///< request / command id
   int servo_mode = 0;
   Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
   int rank = 0;
@@ -180,11 +180,39 @@ struct CycleRequest {
 
 /// The states of the cycle.
 enum class CycleState {
-  kStart, kWaitMarkers, kBackOut, kPark, kWaitP1Check, kMoveToStripeStart, kServoStripe, kWaitPsCheck,
-  kMoveToBwhStart, kServoBook, kWaitDecision, kMoveToPreGrasp, kOpenForGrasp, kInsert, kCloseGripper, kExtract,
-  kMoveToHolder, kPlaceOnHolder, kReleaseOnHolder, kRetreatFromHolder, kParkForUser, kWaitUser,
-  kMoveToHolderPreGrasp, kOpenForHolderGrasp, kApproachHolder, kGraspFromHolder, kLiftFromHolder,
-  kMoveToLowerShelf, kPlaceOnLowerShelf, kReleaseOnLowerShelf, kRetreatFromLowerShelf, kDone, kAborted,
+  kStart,
+  kWaitMarkers,
+  kBackOut,
+  kPark,
+  kWaitP1Check,
+  kMoveToStripeStart,
+  kServoStripe,
+  kWaitPsCheck,
+  kMoveToBwhStart,
+  kServoBook,
+  kWaitDecision,
+  kMoveToPreGrasp,
+  kOpenForGrasp,
+  kInsert,
+  kCloseGripper,
+  kExtract,
+  kMoveToHolder,
+  kPlaceOnHolder,
+  kReleaseOnHolder,
+  kRetreatFromHolder,
+  kParkForUser,
+  kWaitUser,
+  kMoveToHolderPreGrasp,
+  kOpenForHolderGrasp,
+  kApproachHolder,
+  kGraspFromHolder,
+  kLiftFromHolder,
+  kMoveToLowerShelf,
+  kPlaceOnLowerShelf,
+  kReleaseOnLowerShelf,
+  kRetreatFromLowerShelf,
+  kDone,
+  kAborted,
 };
 
 /// Upper-case name of a state ("WAIT_P1_CHECK", ...), as in TASK_STATUS.state.
@@ -193,10 +221,10 @@ std::string cycle_state_name(CycleState s);
 /// What TASK_STATUS says.
 struct CycleStatus {
   std::string state;
-  int books_total = 0;    ///< books known so far: moved + the current one
+  int books_total = 0;  ///< books known so far: moved + the current one
   int books_moved = 0;
-  int current_book = 0;   ///< index of the book being handled (= books_moved)
-  int attempt = 0;        ///< attempt at the current book, 1-based
+  int current_book = 0;  ///< index of the book being handled (= books_moved)
+  int attempt = 0;       ///< attempt at the current book, 1-based
   int failures = 0;
   std::string message;
 };
@@ -275,10 +303,10 @@ class LibraryCycle {
   CycleSettings s_;
   TaskProgress progress_;
   CycleState state_ = CycleState::kStart;
-  CycleState resume_from_ = CycleState::kStart;   ///< the state persisted when the process stopped
+  CycleState resume_from_ = CycleState::kStart;  ///< the state persisted when the process stopped
   int64_t now_ = 0;
   int64_t entry_utime_ = 0;
-  int64_t deadline_ = -1;                          ///< -1 = none
+  int64_t deadline_ = -1;  ///< -1 = none
   int64_t last_id_ = 0;
   int64_t last_command_utime_ = 0;
   std::optional<ArmEvent> arm_;
@@ -293,9 +321,12 @@ class LibraryCycle {
   int64_t servo_request_ = -1;
   int rank_ = 0;
   Eigen::Vector3d bwh_start_ = Eigen::Vector3d::Zero();
-  std::optional<DecisionEvent> early_decision_;    ///< a decision that arrived before its servo status
+  std::optional<DecisionEvent> early_decision_;  ///< a decision that arrived before its servo status
   Eigen::Isometry3d gp_base_ = Eigen::Isometry3d::Identity();
   bool user_event_sent_ = false;
+  bool stopping_foreign_motion_ = false;  ///< started with the arm executing a motion it did not command
+  int64_t last_foreign_stop_utime_ = 0;   ///< when that motion was last sent a STOP
+  int64_t arm_quiet_since_ = -1;          ///< since when the arm has not been executing (-1: it is)
   std::string message_;
   bool progress_changed_ = false;
   bool status_changed_ = true;

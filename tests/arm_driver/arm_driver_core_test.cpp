@@ -54,6 +54,19 @@ TEST(ArmDriverCore, RefusesCommandsBeforeAnyMeasurement) {
   EXPECT_NE(d.command_trajectory(move(home(), home(), 1.0), 1).find("no measurement"), std::string::npos);
 }
 
+TEST(ArmDriverCore, HoldsAMeasuredGripperWidthOnlyWithinTheStroke) {
+  // A (re)started driver holds the plates where they are; a reading a little beyond the stroke
+  // (0.0603 m with max_width 0.0602) must not become a setpoint the gripper rejects.
+  const DriverParams limits;  // make_core() keeps the default stroke [0, 0.0602] m
+  ArmDriverCore d = make_core();
+  d.on_measurement(kT0, home(), limits.gripper_max_width + 0.0001);
+  EXPECT_DOUBLE_EQ(d.update(kT0).gripper_width, limits.gripper_max_width);
+  d.restart(kT0 + 1000, home(), limits.gripper_min_width - 0.001);
+  EXPECT_DOUBLE_EQ(d.update(kT0 + 1000).gripper_width, limits.gripper_min_width);
+  d.restart(kT0 + 2000, home(), 0.031);
+  EXPECT_DOUBLE_EQ(d.update(kT0 + 2000).gripper_width, 0.031);
+}
+
 TEST(ArmDriverCore, ExecutesATrajectoryToItsGoal) {
   ArmDriverCore d = make_core();
   d.on_measurement(kT0, home(), 0.06);

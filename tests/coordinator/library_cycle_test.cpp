@@ -342,6 +342,42 @@ TEST(LibraryCycle, ARestartDuringAPlannedMotionStopsTheArmBeforePlanning) {
   EXPECT_EQ(w.lower.size(), 3u);
 }
 
+TEST(LibraryCycle, ARestartDuringAServoWaitsUntilTheArmStaysStill) {
+  // The predecessor died during a visual servo: a servo command still in flight starts the arm again
+  // after the new coordinator's STOP. It must STOP again and plan only after 0.3 s of a still arm.
+  FakeLibrary w(three_books());
+  auto first = std::make_unique<LibraryCycle>(settings(), std::nullopt);
+  w.run(*first, [&] { return first->state() == CycleState::kMoveToStripeStart && w.arm_state == 1; });
+  const auto progress = first->progress();
+  first.reset();
+  LibraryCycle second(settings(), progress);
+  const size_t before = w.requests.size();
+  int restarted = 0;
+  w.run(second, [&] {
+    // Once, right after the first STOP: the in-flight servo command moves the arm again.
+    int stops = 0;
+    for (size_t i = before; i < w.requests.size(); ++i) stops += w.requests[i].kind == CycleRequest::Kind::kArmStop;
+    if (stops == 1 && restarted == 0) {
+      w.arm_state = 1;
+      restarted = 1;
+    }
+    return second.state() != CycleState::kStart && second.state() != CycleState::kWaitMarkers;
+  });
+  ASSERT_EQ(restarted, 1);
+  int stops = 0;
+  for (size_t i = before; i < w.requests.size(); ++i) {
+    const auto& q = w.requests[i];
+    if (q.kind == CycleRequest::Kind::kArmStop) ++stops;
+    if (q.kind == CycleRequest::Kind::kPlan || q.kind == CycleRequest::Kind::kExecutePlan) {
+      EXPECT_GE(stops, 2) << "planned before the restarted motion was stopped again";
+    }
+  }
+  EXPECT_GE(stops, 2);
+  w.run(second, [&] { return done_or_aborted(second); });
+  ASSERT_EQ(second.state(), CycleState::kDone) << second.status().message;
+  EXPECT_EQ(w.lower.size(), 3u);
+}
+
 TEST(LibraryCycle, ResumeWithABookExpectedInTheGripperButNoContactAborts) {
   FakeLibrary w(three_books());
   LibraryCycle first(settings(), std::nullopt);
