@@ -29,11 +29,18 @@ void ArmDriverCore::on_measurement(int64_t now_utime, const Eigen::VectorXd& q, 
   if (now_utime > now_) now_ = now_utime;
   q_measured_ = q;
   if (q_cmd_.size() == 0) {
-    q_cmd_ = q;
+    q_cmd_ = hold_posture(q);
     qd_cmd_ = Eigen::VectorXd::Zero(q.size());
     last_heard_ = now_;
   }
   if (gripper_width_ < 0) gripper_width_ = hold_width(gripper_width);
+}
+
+Eigen::VectorXd ArmDriverCore::hold_posture(const Eigen::VectorXd& measured) const {
+  // A joint pushed a little past its limit (the elbow after a Cartesian motion into it) would make the
+  // held posture a setpoint the arm rejects: hold the nearest posture within the limits.
+  if (limits_.lower.size() != measured.size() || limits_.upper.size() != measured.size()) return measured;
+  return measured.cwiseMax(limits_.lower).cwiseMin(limits_.upper);
 }
 
 double ArmDriverCore::hold_width(double measured) const {
@@ -47,7 +54,7 @@ void ArmDriverCore::restart(int64_t now_utime, const Eigen::VectorXd& q, double 
   last_update_ = -1;
   last_heard_ = now_utime;
   q_measured_ = q;
-  q_cmd_ = q;
+  q_cmd_ = hold_posture(q);
   qd_cmd_ = Eigen::VectorXd::Zero(q.size());
   gripper_width_ = hold_width(gripper_width);
   stop("the arm's source restarted (simulation reset): motion stopped, holding the new position");

@@ -90,6 +90,8 @@ class ArmDriverCore {
  private:
   /// A measured plate distance as a gripper target: clamped to [gripper_min_width, gripper_max_width].
   double hold_width(double measured) const;
+  /// A measured posture as the held setpoint: clamped to the joint limits.
+  Eigen::VectorXd hold_posture(const Eigen::VectorXd& measured) const;
   enum class Mode { kHold, kTrajectory, kCartesian };
   void stop(const std::string& reason);
 

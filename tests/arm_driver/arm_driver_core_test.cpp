@@ -67,6 +67,26 @@ TEST(ArmDriverCore, HoldsAMeasuredGripperWidthOnlyWithinTheStroke) {
   EXPECT_DOUBLE_EQ(d.update(kT0 + 2000).gripper_width, 0.031);
 }
 
+TEST(ArmDriverCore, HoldsAMeasuredPostureOnlyWithinTheJointLimits) {
+  // A restarted driver finds the elbow pushed 0.01 rad past its limit: it holds the limit itself,
+  // a setpoint the arm accepts, not the measured value.
+  ArmDriverCore d = make_core();
+  Eigen::VectorXd q = home();
+  q[3] = d.limits().upper[3] + 0.01;
+  d.restart(kT0, q, 0.03);
+  const DriverSetpoint sp = d.update(kT0);
+  EXPECT_DOUBLE_EQ(sp.q[3], d.limits().upper[3]);
+  for (int j = 0; j < 7; ++j) {
+    if (j != 3) {
+      EXPECT_DOUBLE_EQ(sp.q[j], q[j]);
+    }
+  }
+  ArmDriverCore fresh = make_core();
+  q[3] = fresh.limits().lower[3] - 0.02;
+  fresh.on_measurement(kT0, q, 0.03);
+  EXPECT_DOUBLE_EQ(fresh.update(kT0).q[3], fresh.limits().lower[3]);
+}
+
 TEST(ArmDriverCore, ExecutesATrajectoryToItsGoal) {
   ArmDriverCore d = make_core();
   d.on_measurement(kT0, home(), 0.06);
