@@ -132,6 +132,13 @@ std::string Config::get_choice(const std::string& key, const std::vector<std::st
   fail(key, "= '" + v + "' is not one of: " + list);
 }
 
+std::string Config::get_channel(const std::string& key) const {
+  const std::string v = get<std::string>(key);
+  if (v.empty()) fail(key, "channel name must not be empty");
+  if (v.find_first_of(" \t\n") != std::string::npos) fail(key, "= '" + v + "': a channel name has no spaces");
+  return v;
+}
+
 std::vector<double> Config::get_vector(const std::string& key, size_t n) const {
   const auto v = get<std::vector<double>>(key);
   if (v.size() != n) fail(key, "must be a list of " + std::to_string(n) + " numbers, has " + std::to_string(v.size()));

@@ -46,6 +46,8 @@ class Config {
   int get_int(const std::string& key, int min, int max) const;
   /// Required string that must be one of `allowed`.
   std::string get_choice(const std::string& key, const std::vector<std::string>& allowed) const;
+  /// Required LCM channel name: a non-empty string without spaces.
+  std::string get_channel(const std::string& key) const;
   /// Required list of exactly `n` numbers.
   std::vector<double> get_vector(const std::string& key, size_t n) const;
 

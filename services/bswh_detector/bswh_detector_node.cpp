@@ -4,13 +4,16 @@
 #include <cmath>
 
 #include "common/image_conversion.h"
+#include "services/bswh_detector/stripe_debug_overlay.h"
 
 namespace bookgrasp {
 
 BswhDetectorSettings BswhDetectorSettings::from_config(const Config& root) {
   BswhDetectorSettings s;
-  s.input_channel = root.get<std::string>("channels.input");
-  s.output_channel = root.get<std::string>("channels.output");
+  s.input_channel = root.get_channel("channels.input");
+  s.output_channel = root.get_channel("channels.output");
+  s.debug_image_channel = root.get_channel("channels.debug_image");
+  s.publish_debug_image = root.get<bool>("debug.publish_image");
   s.stripe = StripeDetectionParams::from_config(root.child("stripe"));
   s.measure_processing_time = root.get<bool>("diagnostics.measure_processing_time");
   return s;
@@ -21,7 +24,7 @@ BswhDetectorNode::BswhDetectorNode(const BswhDetectorSettings& settings)
   subscribe(settings_.input_channel, &BswhDetectorNode::on_image);
 }
 
-bool BswhDetectorNode::process(const hand_image_t& msg, stripe_features_t* out, std::string* reason) {
+bool BswhDetectorNode::process(const hand_image_t& msg, stripe_features_t* out, std::string* reason, image_t* debug) {
   const auto start = std::chrono::steady_clock::now();
   cv::Mat image;
   try {
@@ -54,21 +57,25 @@ bool BswhDetectorNode::process(const hand_image_t& msg, stripe_features_t* out, 
   out->centre_line_px[2] = d.line_end.x;
   out->centre_line_px[3] = d.line_end.y;
   out->thickness_px = d.thickness_px;
-  out->processing_ms =
-      settings_.measure_processing_time
-          ? std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count()
-          : 0.0;
+  out->processing_ms = settings_.measure_processing_time
+                           ? std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count()
+                           : 0.0;
+  if (debug && settings_.publish_debug_image)
+    *debug = encode_png(draw_bswh_overlay(image, d, implementation() + " utime " + std::to_string(out->utime)),
+                        out->utime, msg.image.frame);
   return true;
 }
 
 void BswhDetectorNode::on_image(const hand_image_t& msg) {
   stripe_features_t out;
+  image_t debug;
   std::string reason;
-  if (!process(msg, &out, &reason)) {
+  if (!process(msg, &out, &reason, &debug)) {
     reject(settings_.input_channel, reason);
     return;
   }
   publish(settings_.output_channel, out);
+  if (settings_.publish_debug_image) publish(settings_.debug_image_channel, debug);
 }
 
 }  // namespace bookgrasp

@@ -4,14 +4,17 @@
 #include <cmath>
 
 #include "common/image_conversion.h"
+#include "services/bwh_detector/bwh_debug_overlay.h"
 
 namespace bookgrasp {
 
 BwhDetectorSettings BwhDetectorSettings::from_config(const Config& root) {
   BwhDetectorSettings s;
-  s.input_channel = root.get<std::string>("channels.input");
-  s.output_channel = root.get<std::string>("channels.output");
-  s.servo_request_channel = root.get<std::string>("channels.servo_request");
+  s.input_channel = root.get_channel("channels.input");
+  s.output_channel = root.get_channel("channels.output");
+  s.servo_request_channel = root.get_channel("channels.servo_request");
+  s.debug_image_channel = root.get_channel("channels.debug_image");
+  s.publish_debug_image = root.get<bool>("debug.publish_image");
   s.method = root.get_choice("method", {"page_faces", "canny_regions"});
   s.books = BookDetectionParams::from_config(root.child("books"));
   s.page_faces = PageFaceParams::from_config(root.child("page_faces"));
@@ -51,7 +54,7 @@ BwhDetectorNode::BwhDetectorNode(const BwhDetectorSettings& settings)
   subscribe(settings_.servo_request_channel, &BwhDetectorNode::on_request);
 }
 
-bool BwhDetectorNode::process(const hand_image_t& msg, book_features_hand_t* out, std::string* reason) {
+bool BwhDetectorNode::process(const hand_image_t& msg, book_features_hand_t* out, std::string* reason, image_t* debug) {
   const auto start = std::chrono::steady_clock::now();
   cv::Mat image;
   if (!decode_hand_image(msg, &image, reason)) return false;
@@ -70,8 +73,8 @@ bool BwhDetectorNode::process(const hand_image_t& msg, book_features_hand_t* out
   out->slope_rad = 0.0;
   out->book_width_px = 0.0;
   if (d.found && rank_ >= static_cast<int>(d.ranking.size())) {
-    out->failure_reason = "rank " + std::to_string(rank_) + " requested but only " +
-                          std::to_string(d.ranking.size()) + " book(s) accepted";
+    out->failure_reason = "rank " + std::to_string(rank_) + " requested but only " + std::to_string(d.ranking.size()) +
+                          " book(s) accepted";
   } else if (d.found) {
     const BookCandidate& b = d.candidates[static_cast<size_t>(d.ranking[static_cast<size_t>(rank_)])];
     out->found = true;
@@ -99,27 +102,32 @@ bool BwhDetectorNode::process(const hand_image_t& msg, book_features_hand_t* out
     out->candidates.push_back(m);
   }
   out->num_candidates = static_cast<int32_t>(out->candidates.size());
-  out->processing_ms =
-      settings_.measure_processing_time
-          ? std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count()
-          : 0.0;
+  out->processing_ms = settings_.measure_processing_time
+                           ? std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count()
+                           : 0.0;
+  if (debug && settings_.publish_debug_image)
+    *debug = encode_png(draw_bwh_overlay(image, d, rank_, settings_.method + " utime " + std::to_string(out->utime)),
+                        out->utime, msg.image.frame);
   return true;
 }
 
 void BwhDetectorNode::on_image(const hand_image_t& msg) {
   book_features_hand_t out;
+  image_t debug;
   std::string reason;
-  if (!process(msg, &out, &reason)) {
+  if (!process(msg, &out, &reason, &debug)) {
     reject(settings_.input_channel, reason);
     return;
   }
   publish(settings_.output_channel, out);
+  if (settings_.publish_debug_image) publish(settings_.debug_image_channel, debug);
 }
 
 void BwhDetectorNode::on_request(const servo_request_t& msg) {
   if (msg.mode != servo_request_t::BOOK_CORNER) return;
   if (msg.rank_from_right < 0) {
-    reject(settings_.servo_request_channel, "rank_from_right must be >= 0 (got " + std::to_string(msg.rank_from_right) + ")");
+    reject(settings_.servo_request_channel,
+           "rank_from_right must be >= 0 (got " + std::to_string(msg.rank_from_right) + ")");
     return;
   }
   rank_ = msg.rank_from_right;

@@ -3,6 +3,7 @@
 /// The bwh_detector component: HAND_IMAGE -> BOOK_FEATURES_HAND (the book
 /// ranked `rank_from_right`, its corner R, slope, width, and every candidate
 /// with its reason). SERVO_REQUEST (BOOK_CORNER) sets the rank to report.
+/// With debug.publish_image, also BWH_DEBUG_IMAGE: a PNG of the candidates, R and slope.
 
 #include <string>
 
@@ -18,12 +19,14 @@ namespace bookgrasp {
 
 /// Everything the BwH node reads from its configuration.
 struct BwhDetectorSettings {
-  std::string input_channel;          ///< channels.input (hand_image_t)
-  std::string output_channel;         ///< channels.output (book_features_hand_t)
-  std::string servo_request_channel;  ///< channels.servo_request (servo_request_t)
-  std::string method;                 ///< method: "page_faces" (rendered/real views, default) or "canny_regions"
-  BookDetectionParams books;          ///< books.* (canny_regions)
-  PageFaceParams page_faces;          ///< page_faces.* (page_faces)
+  std::string input_channel;            ///< channels.input (hand_image_t)
+  std::string output_channel;           ///< channels.output (book_features_hand_t)
+  std::string servo_request_channel;    ///< channels.servo_request (servo_request_t)
+  std::string debug_image_channel;      ///< channels.debug_image (image_t, PNG)
+  bool publish_debug_image = false;     ///< debug.publish_image
+  std::string method;                   ///< method: "page_faces" (rendered/real views, default) or "canny_regions"
+  BookDetectionParams books;            ///< books.* (canny_regions)
+  PageFaceParams page_faces;            ///< page_faces.* (page_faces)
   bool measure_processing_time = true;  ///< diagnostics.measure_processing_time
 
   /// Reads the configuration root. Throws ConfigError naming a bad key.
@@ -39,8 +42,9 @@ class BwhDetectorNode : public Component {
  public:
   /// Subscribes the input and servo request channels.
   explicit BwhDetectorNode(const BwhDetectorSettings& settings);
-  /// The handler's work without a bus: false and a reason for an unusable image.
-  bool process(const hand_image_t& msg, book_features_hand_t* out, std::string* reason);
+  /// The handler's work without a bus: false and a reason for an unusable image. Fills
+  /// `debug` (when not null and debug.publish_image is on) with the overlay as PNG.
+  bool process(const hand_image_t& msg, book_features_hand_t* out, std::string* reason, image_t* debug = nullptr);
   /// The rank currently reported (0 = right-most).
   int rank_from_right() const { return rank_; }
 

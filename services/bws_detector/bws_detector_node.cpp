@@ -12,19 +12,15 @@ namespace bookgrasp {
 
 BwsDetectorSettings BwsDetectorSettings::from_config(const Config& root) {
   BwsDetectorSettings s;
-  s.stereo_channel = root.get<std::string>("channels.stereo");
-  s.markers_channel = root.get<std::string>("channels.markers");
-  s.corner_channel = root.get<std::string>("channels.corner");
-  s.debug_image_channel = root.get<std::string>("channels.debug_image");
+  s.stereo_channel = root.get_channel("channels.stereo");
+  s.markers_channel = root.get_channel("channels.markers");
+  s.corner_channel = root.get_channel("channels.corner");
+  s.debug_image_channel = root.get_channel("channels.debug_image");
   s.publish_debug_image = root.get<bool>("debug.publish_image");
   s.cart_marker_role = root.get<std::string>("cart.marker_role");
+  s.max_pending_frames = root.get_int("pairing.max_pending_frames", 0, 100);
   s.measure_processing_time = root.get<bool>("diagnostics.measure_processing_time");
   s.params = bws::BwsParams::from_config(root);
-  for (const auto& [key, v] : {std::pair<const char*, const std::string*>{"channels.stereo", &s.stereo_channel},
-                               {"channels.markers", &s.markers_channel},
-                               {"channels.corner", &s.corner_channel},
-                               {"channels.debug_image", &s.debug_image_channel}})
-    if (v->empty()) throw ConfigError(root.source() + ": " + root.path_of(key) + ": channel name must not be empty");
   return s;
 }
 
@@ -57,7 +53,8 @@ std::string stereo_input_from_frame(const stereo_frame_t& f, bws::StereoInput* i
   if (c.fx <= 0 || c.fy <= 0) return "left calibration focal lengths must be > 0";
   if (!(std::isfinite(f.baseline_m) && f.baseline_m > 0))
     return "baseline_m must be finite and > 0 (got " + std::to_string(f.baseline_m) + ")";
-  if (!is_valid_pose(c.camera_in_base)) return "left calibration camera_in_base is not a valid pose (NaN or quaternion)";
+  if (!is_valid_pose(c.camera_in_base))
+    return "left calibration camera_in_base is not a valid pose (NaN or quaternion)";
   in->left = left;
   in->right = right;
   in->geometry = {c.fx, c.fy, c.cx, c.cy, f.baseline_m};
@@ -75,20 +72,25 @@ std::string BwsDetectorNode::take_markers(const marker_detections_t& msg) {
   if (msg.num_markers != int32_t(msg.markers.size()))
     return "num_markers " + std::to_string(msg.num_markers) + " does not match the " +
            std::to_string(msg.markers.size()) + " markers sent";
+  std::optional<Eigen::Isometry3d> cart;
   for (const marker_t& m : msg.markers) {
     if (m.role != s_.cart_marker_role) continue;
     if (!is_valid_pose(m.pose_in_base))
       return "cart marker " + std::to_string(m.id) + " has an invalid pose_in_base (NaN or not a unit quaternion)";
-    marker_in_base_ = pose_to_isometry(m.pose_in_base);
-    marker_utime_ = msg.utime;
-    return "";
+    cart = pose_to_isometry(m.pose_in_base);
+    break;
   }
-  return "";  // no cart marker in this message: keep the previous one
+  track_.add(msg.utime, cart);  // without the cart marker: still says the detector answered up to msg.utime
+  return "";
 }
 
 void BwsDetectorNode::on_markers(const marker_detections_t& msg) {
   const std::string why = take_markers(msg);
   if (!why.empty()) reject(s_.markers_channel, why);
+  while (!pending_.empty() && track_.covers(pending_.front().utime)) {
+    answer(pending_.front());
+    pending_.pop_front();
+  }
 }
 
 namespace {
@@ -101,16 +103,26 @@ std::string BwsDetectorNode::process(const stereo_frame_t& frame, book_corner_st
   bws::StereoInput in;
   std::string why = stereo_input_from_frame(frame, &in);
   if (!why.empty()) return why;
-  if (!marker_in_base_)
+  const std::optional<bws::CartObservation> cart = track_.nearest(frame.utime);
+  if (!cart)
     return "no cart marker (role '" + s_.cart_marker_role + "') received on " + s_.markers_channel +
            " yet: is the marker_detector running and the cart marker visible?";
-  const double age_s = double(frame.utime - marker_utime_) * 1e-6;
+  const double age_s = double(frame.utime - cart->utime) * 1e-6;
+  if (age_s * 1e6 < -double(bws::CartMarkerTrack::kRestartUtime)) {
+    // Every cart marker kept is from more than a second after the frame: the frames' source restarted
+    // (a restarted simulation's clock starts over). Those markers belong to the old timeline: drop them
+    // and wait for one of the new (skipped, not rejected, like the start-up).
+    track_.clear();
+    return "no cart marker (role '" + s_.cart_marker_role + "') received on " + s_.markers_channel +
+           " since the stereo source restarted (the nearest is " + std::to_string(-age_s) + " s after this frame)";
+  }
   if (std::fabs(age_s) > s_.params.cart.max_marker_age_s)
-    return "latest cart marker is " + std::to_string(age_s) + " s from the stereo frame (limit cart.max_marker_age_s = " +
+    return "nearest cart marker is " + std::to_string(age_s) +
+           " s from the stereo frame (limit cart.max_marker_age_s = " +
            std::to_string(s_.params.cart.max_marker_age_s) + ")";
   bws::BwsOutput r;
   try {
-    r = bws::run_bws(in, *marker_in_base_, s_.params, s_.measure_processing_time);
+    r = bws::run_bws(in, cart->cart_in_base, s_.params, s_.measure_processing_time);
   } catch (const std::invalid_argument& e) {
     return e.what();
   }
@@ -164,13 +176,25 @@ std::string BwsDetectorNode::process(const stereo_frame_t& frame, book_corner_st
 }
 
 void BwsDetectorNode::on_stereo(const stereo_frame_t& frame) {
+  // Wait for the marker detector's answer for this frame (MARKERS at its utime), so the pair is
+  // the same live, in a replay and in a chain replay; a detector that is late or down holds at
+  // most pairing.max_pending_frames frames back, then the nearest cart marker is used.
+  pending_.push_back(frame);
+  while (!pending_.empty() &&
+         (track_.covers(pending_.front().utime) || pending_.size() > size_t(s_.max_pending_frames))) {
+    answer(pending_.front());
+    pending_.pop_front();
+  }
+}
+
+void BwsDetectorNode::answer(const stereo_frame_t& frame) {
   book_corner_stereo_t out;
   image_t debug;
   const std::string why = process(frame, &out, &debug);
   if (!why.empty()) {
     // Before the first cart marker the frame is not bad input, the system is starting (or this
     // detector just restarted): skipped and said in last_error, not counted as a rejection.
-    if (!marker_in_base_)
+    if (track_.empty())
       report_error("waiting: " + why);
     else
       reject(s_.stereo_channel, why);

@@ -5,8 +5,11 @@
 /// region's verdict) and an optional debug picture. Both implementations (GoD,
 /// PCL) are this component with another `service.implementation`; they publish
 /// the same message on the same channel with their name in `implementation`.
+/// A frame is answered with the cart marker from the same frame (MARKERS at its
+/// utime): it waits for it, up to pairing.max_pending_frames frames.
 
 #include <cstdint>
+#include <deque>
 #include <optional>
 #include <string>
 
@@ -18,19 +21,21 @@
 #include "common/component.h"
 #include "common/config.h"
 #include "services/bws_detector/bws_pipeline.h"
+#include "services/bws_detector/cart_marker_track.h"
 
 namespace bookgrasp {
 
 /// Everything the bws_detector reads from its configuration.
 struct BwsDetectorSettings {
-  std::string stereo_channel;       ///< channels.stereo (stereo_frame_t)
-  std::string markers_channel;      ///< channels.markers (marker_detections_t)
-  std::string corner_channel;       ///< channels.corner (book_corner_stereo_t)
-  std::string debug_image_channel;  ///< channels.debug_image (image_t, PNG)
-  bool publish_debug_image = false; ///< debug.publish_image
-  std::string cart_marker_role;     ///< cart.marker_role: role of the cart marker in MARKERS
+  std::string stereo_channel;           ///< channels.stereo (stereo_frame_t)
+  std::string markers_channel;          ///< channels.markers (marker_detections_t)
+  std::string corner_channel;           ///< channels.corner (book_corner_stereo_t)
+  std::string debug_image_channel;      ///< channels.debug_image (image_t, PNG)
+  bool publish_debug_image = false;     ///< debug.publish_image
+  std::string cart_marker_role;         ///< cart.marker_role: role of the cart marker in MARKERS
+  int max_pending_frames = 3;           ///< pairing.max_pending_frames: frames held for their MARKERS (0 = none)
   bool measure_processing_time = true;  ///< diagnostics.measure_processing_time (wall-time *_ms fields)
-  bws::BwsParams params;            ///< algorithm (service.implementation, disparity, god|pcl, selection, cart)
+  bws::BwsParams params;                ///< algorithm (service.implementation, disparity, god|pcl, selection, cart)
 
   /// Reads the whole configuration root. Throws ConfigError naming a bad key.
   static BwsDetectorSettings from_config(const Config& root);
@@ -48,12 +53,14 @@ class BwsDetectorNode : public Component {
   /// Subscribes the stereo and marker channels.
   explicit BwsDetectorNode(const BwsDetectorSettings& settings);
 
-  /// The handler's core, usable without a bus: answers one frame with the
-  /// latest cart marker. Returns "" and fills `out` (and `debug` if not null
-  /// and the debug image is enabled), or the reason the frame is rejected.
+  /// The handler's core, usable without a bus: answers one frame with the cart
+  /// marker seen at its utime (else the nearest in time). Returns "" and fills
+  /// `out` (and `debug` if not null and the debug image is enabled), or the
+  /// reason the frame is rejected.
   std::string process(const stereo_frame_t& frame, book_corner_stereo_t* out, image_t* debug);
 
-  /// Takes the cart marker from a MARKERS message; returns "" or why it was refused.
+  /// Records the cart marker of a MARKERS message (or its absence) at the message's utime;
+  /// returns "" or why the message was refused.
   std::string take_markers(const marker_detections_t& msg);
 
   /// The full result of the last frame process() answered (images, regions, verdicts), for
@@ -63,10 +70,11 @@ class BwsDetectorNode : public Component {
  private:
   void on_stereo(const stereo_frame_t& frame);
   void on_markers(const marker_detections_t& msg);
+  void answer(const stereo_frame_t& frame);  ///< process() and publish, or reject / wait
 
   BwsDetectorSettings s_;
-  std::optional<Eigen::Isometry3d> marker_in_base_;
-  int64_t marker_utime_ = 0;
+  bws::CartMarkerTrack track_;
+  std::deque<stereo_frame_t> pending_;  ///< frames waiting for their MARKERS, oldest first
   bws::BwsOutput last_;
 };
 

@@ -5,6 +5,8 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include "common/image_caption.h"
+
 namespace bookgrasp::bws {
 
 cv::Mat draw_bws_overlay(const cv::Mat& left, const BwsOutput& r, const std::string& title) {
@@ -40,11 +42,7 @@ cv::Mat draw_bws_overlay(const cv::Mat& left, const BwsOutput& r, const std::str
   }
   char buf[256];
   int line = 0;
-  const auto text = [&](const std::string& s, const cv::Scalar& colour) {
-    const cv::Point at(6, 16 + 16 * line++);
-    cv::putText(img, s, at, cv::FONT_HERSHEY_SIMPLEX, 0.45, cv::Scalar(0, 0, 0), 3, cv::LINE_AA);
-    cv::putText(img, s, at, cv::FONT_HERSHEY_SIMPLEX, 0.45, colour, 1, cv::LINE_AA);
-  };
+  const auto text = [&](const std::string& s, const cv::Scalar& colour) { draw_caption_line(&img, line++, s, colour); };
   int candidates = 0;
   for (const RegionVerdict& v : r.selection.regions) candidates += v.candidate;
   std::snprintf(buf, sizeof buf, "%s: %zu regions, %d candidates (green), selected red", title.c_str(), K, candidates);

@@ -1,6 +1,8 @@
 // Tests of the bwh_detector and bswh_detector components on an in-process bus:
 // outputs against the synthetic truth, utime, rank requests, bad images, shipped configs.
 #include <cmath>
+#include <map>
+#include <regex>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -145,6 +147,67 @@ TEST_F(HandNodes, NoStripeIsPublishedAsNotFound) {
   ASSERT_EQ(col.stripes.size(), 1u);
   EXPECT_FALSE(col.stripes[0].found);
   EXPECT_FALSE(col.stripes[0].failure_reason.empty());
+}
+
+TEST(HandNodesDebug, DebugImagesShowRAndTheStripeEndOnlyWhenEnabled) {
+  Composition comp;
+  BwhDetectorSettings bs = BwhDetectorSettings::from_config(Config::load_file(kConfigDir + "bwh_detector.yaml"));
+  bs.method = "canny_regions";
+  BswhDetectorSettings ss = BswhDetectorSettings::from_config(Config::load_file(kConfigDir + "bswh_detector.yaml"));
+  EXPECT_FALSE(bs.publish_debug_image);  // off by default: ~0.3 MB per frame
+  EXPECT_FALSE(ss.publish_debug_image);
+  bs.publish_debug_image = ss.publish_debug_image = true;
+  comp.add(std::make_unique<BwhDetectorNode>(bs));
+  comp.add(std::make_unique<BswhDetectorNode>(ss));
+  std::map<std::string, std::vector<image_t>> got;
+  struct Sink {
+    std::map<std::string, std::vector<image_t>>* got;
+    void on(const lcm::ReceiveBuffer*, const std::string& ch, const image_t* m) { (*got)[ch].push_back(*m); }
+  } sink{&got};
+  comp.bus().subscribe("BWH_DEBUG_IMAGE", &Sink::on, &sink);
+  comp.bus().subscribe("BSWH_DEBUG_IMAGE", &Sink::on, &sink);
+  test::SynthTruth truth;
+  const cv::Mat rgb = test::render_scene(test::default_scene(), &truth);
+  const hand_image_t msg = hand_image(rgb, 4242);
+  comp.bus().publish("HAND_IMAGE", &msg);
+  comp.spin();
+  ASSERT_EQ(got["BWH_DEBUG_IMAGE"].size(), 1u);
+  ASSERT_EQ(got["BSWH_DEBUG_IMAGE"].size(), 1u);
+  for (const auto& [channel, images] : got) {
+    const image_t& im = images[0];
+    EXPECT_EQ(im.utime, 4242) << channel;
+    EXPECT_EQ(im.pixel_format, image_t::PNG) << channel;
+    EXPECT_EQ(im.frame, "hand_camera") << channel;
+  }
+  // The true corner R and the true stripe end: each overlay has changed the picture there (the cross).
+  const auto changed_near = [&](const image_t& im, cv::Point2d p) {
+    const cv::Mat o = image_to_mat(im);
+    EXPECT_EQ(o.size(), rgb.size());
+    cv::Mat diff;
+    const cv::Rect box = cv::Rect(cv::Point(int(p.x) - 4, int(p.y) - 4), cv::Size(9, 9)) & cv::Rect({}, rgb.size());
+    cv::absdiff(o(box), rgb(box), diff);
+    return cv::countNonZero(diff.reshape(1) > 60);
+  };
+  EXPECT_GT(changed_near(got["BWH_DEBUG_IMAGE"][0], truth.r), 5);
+  EXPECT_GT(changed_near(got["BSWH_DEBUG_IMAGE"][0], truth.stripe_end), 5);
+}
+
+TEST(HandConfigs, AnEmptyDebugChannelIsABadKey) {
+  for (const char* name : {"bwh_detector.yaml", "bswh_detector.yaml"}) {
+    const Config root =
+        Config::from_string(std::regex_replace(Config::load_file(kConfigDir + name).dump(),
+                                               std::regex("debug_image: BS?WH_DEBUG_IMAGE"), "debug_image: \"\""),
+                            name);
+    try {
+      if (std::string(name) == "bwh_detector.yaml")
+        BwhDetectorSettings::from_config(root);
+      else
+        BswhDetectorSettings::from_config(root);
+      ADD_FAILURE() << name << ": an empty channels.debug_image was accepted";
+    } catch (const ConfigError& e) {
+      EXPECT_NE(std::string(e.what()).find("channels.debug_image"), std::string::npos) << e.what();
+    }
+  }
 }
 
 TEST(HandConfigs, ShippedFilesAreCompleteAndValid) {

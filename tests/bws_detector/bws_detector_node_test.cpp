@@ -24,7 +24,9 @@ const std::string kConfigDir = std::string(BOOKGRASP_SOURCE_DIR) + "/config/serv
 struct Collector {
   std::vector<book_corner_stereo_t> corners;
   std::vector<image_t> debug;
-  void on_corner(const lcm::ReceiveBuffer*, const std::string&, const book_corner_stereo_t* m) { corners.push_back(*m); }
+  void on_corner(const lcm::ReceiveBuffer*, const std::string&, const book_corner_stereo_t* m) {
+    corners.push_back(*m);
+  }
   void on_debug(const lcm::ReceiveBuffer*, const std::string&, const image_t* m) { debug.push_back(*m); }
 };
 
@@ -195,10 +197,12 @@ class BwsNodeBadInput : public BwsNode {
     EXPECT_NE(node->last_error().find(what), std::string::npos) << node->last_error();
   }
   // Before any cart marker: no output, the reason in last_error, but not a rejection (start-up, not bad input).
+  // Without MARKERS covering the frame it is held (pairing.max_pending_frames): send one more than that.
   void expect_waiting(const stereo_frame_t& frame, const marker_detections_t* markers) {
     const int64_t before = node->rejected_total();
     if (markers) comp.bus().publish("MARKERS", markers);
-    comp.bus().publish("STEREO_IMAGES", &frame);
+    for (int i = 0; i <= fixture().settings("bws_detector.yaml").max_pending_frames; ++i)
+      comp.bus().publish("STEREO_IMAGES", &frame);
     comp.spin();
     EXPECT_TRUE(col.corners.empty());
     EXPECT_EQ(node->rejected_total(), before);
@@ -217,7 +221,81 @@ TEST_F(BwsNodeBadInput, MissingCartMarker) {
 TEST_F(BwsNodeBadInput, StaleCartMarker) {
   marker_detections_t old = fixture().markers;
   old.utime = fixture().frame.utime - 60000000;  // 60 s before the frame, limit 10 s
-  expect_rejected(fixture().frame, &old, "max_marker_age_s");
+  comp.bus().publish("MARKERS", &old);
+  marker_detections_t none_now = fixture().markers;  // the detector's answer for the frame: no cart marker
+  none_now.markers.clear();
+  none_now.num_markers = 0;
+  expect_rejected(fixture().frame, &none_now, "max_marker_age_s");
+}
+
+// The marker detector's answer for a frame can arrive after the frame (it works on the same image):
+// the frame waits for it and is answered with the cart pose of its own utime, exactly as if the
+// MARKERS message had come first (the same output live, in a replay and in a chain replay).
+TEST_F(BwsNodeBadInput, AFrameIsPairedWithTheMarkerOfItsUtimeWhicheverArrivesFirst) {
+  const Fixture& f = fixture();
+  marker_detections_t earlier = f.markers;  // a frame before, the cart measured 3 cm off
+  earlier.utime = f.frame.utime - 100000;
+  earlier.markers[0].pose_in_base.position[1] += 0.03;
+  comp.bus().publish("MARKERS", &earlier);
+  comp.bus().publish("STEREO_IMAGES", &f.frame);
+  comp.spin();
+  EXPECT_TRUE(col.corners.empty());  // held for its MARKERS
+  comp.bus().publish("MARKERS", &f.markers);
+  comp.spin();
+  ASSERT_EQ(col.corners.size(), 1u) << node->last_error();
+  // Reference: the marker first, then the frame, on a fresh node.
+  Composition ref;
+  ref.add(std::make_unique<BwsDetectorNode>(f.settings("bws_detector.yaml")));
+  Collector ref_col;
+  ref.bus().subscribe("BOOK_CORNER_STEREO", &Collector::on_corner, &ref_col);
+  ref.bus().publish("MARKERS", &f.markers);
+  ref.bus().publish("STEREO_IMAGES", &f.frame);
+  ref.spin();
+  ASSERT_EQ(ref_col.corners.size(), 1u);
+  std::vector<uint8_t> a(size_t(col.corners[0].getEncodedSize())), b(size_t(ref_col.corners[0].getEncodedSize()));
+  col.corners[0].encode(a.data(), 0, int(a.size()));
+  ref_col.corners[0].encode(b.data(), 0, int(b.size()));
+  EXPECT_EQ(a, b);
+}
+
+TEST_F(BwsNodeBadInput, WithTheMarkerDetectorSilentFramesAreHeldAtMostMaxPendingThenAnswered) {
+  const Fixture& f = fixture();
+  const int max_pending = f.settings("bws_detector.yaml").max_pending_frames;
+  ASSERT_GT(max_pending, 0);
+  comp.bus().publish("MARKERS", &f.markers);
+  stereo_frame_t later = f.frame;
+  for (int i = 1; i <= max_pending; ++i) {
+    later.utime = f.frame.utime + i * 100000;
+    comp.bus().publish("STEREO_IMAGES", &later);
+  }
+  comp.spin();
+  EXPECT_TRUE(col.corners.empty());
+  later.utime = f.frame.utime + (max_pending + 1) * 100000;
+  comp.bus().publish("STEREO_IMAGES", &later);
+  comp.spin();
+  ASSERT_EQ(col.corners.size(), 1u) << node->last_error();
+  EXPECT_EQ(col.corners[0].utime, f.frame.utime + 100000);  // the oldest, with the nearest marker
+  EXPECT_EQ(node->rejected_total(), 0);
+}
+
+TEST_F(BwsNodeBadInput, AMarkerFromBeforeTheStereoSourceRestartedIsDroppedNotARejection) {
+  // A restarted simulation's clock starts over: the kept marker is 30 s "after" the new frames.
+  marker_detections_t old_timeline = fixture().markers;
+  old_timeline.utime = fixture().frame.utime + 30000000;
+  comp.bus().publish("MARKERS", &old_timeline);
+  comp.spin();
+  const int64_t before = node->rejected_total();
+  comp.bus().publish("STEREO_IMAGES", &fixture().frame);
+  comp.spin();
+  EXPECT_TRUE(col.corners.empty());
+  EXPECT_EQ(node->rejected_total(), before);
+  EXPECT_NE(node->last_error().find("since the stereo source restarted"), std::string::npos) << node->last_error();
+  // The first marker of the new timeline is used again.
+  comp.bus().publish("MARKERS", &fixture().markers);
+  comp.bus().publish("STEREO_IMAGES", &fixture().frame);
+  comp.spin();
+  EXPECT_EQ(col.corners.size(), 1u);
+  EXPECT_EQ(node->rejected_total(), before);
 }
 
 TEST_F(BwsNodeBadInput, InvalidMarkerPose) {

@@ -39,7 +39,13 @@ if grep -qw coordinator <<< "$names"; then
     --field message --timeout 20 > "$TMP/resumed.txt" || fail "the restarted coordinator publishes no TASK_STATUS"
   echo "restarted coordinator: $(cat "$TMP/resumed.txt")"
 fi
-for name in $names; do
+# sim_world last: a restarted simulation resets the whole world (books, arm posture, clock), so after it
+# the task in progress acts on a world that jumped (its next trajectory starts where the arm no longer
+# is, and the driver rightly refuses it). Right after that restart nobody may reject input; the kills
+# that follow it would no longer test a neighbour's restart but a teleported world.
+order="$(grep -vx sim_world <<< "$(tr ' ' '\n' <<< "$names")" | paste -sd' ' -)"
+grep -qx sim_world <<< "$(tr ' ' '\n' <<< "$names")" && order="$order sim_world"
+for name in $order; do
   old=$(supervisorctl -c "$CONF" pid "$name")
   kill -9 "$old"
   new=$old
