@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <cstdio>
 #include <initializer_list>
 
@@ -11,6 +12,8 @@ namespace {
 constexpr int kArmIdle = 0;
 constexpr int kArmExecuting = 1;
 constexpr double kForeignMotionSettleS = 0.3;  ///< still this long after stopping a predecessor's motion
+constexpr double kPlanStartToleranceRad = 0.01; ///< a plan whose start the arm has left by more is made again
+                                                ///< (the driver accepts 0.03 rad)
 constexpr int kArmStopped = 2;
 constexpr int kArmFault = 3;
 constexpr int kServoBookCorner = 1;
@@ -53,6 +56,14 @@ CycleRequest make_request(CycleRequest::Kind k) {
 
 bool in(CycleState s, std::initializer_list<CycleState> set) {
   return std::find(set.begin(), set.end(), s) != set.end();
+}
+
+/// Largest |a_i - b_i|; infinity when the sizes differ.
+double max_joint_difference(const std::vector<double>& a, const std::vector<double>& b) {
+  if (a.size() != b.size()) return std::numeric_limits<double>::infinity();
+  double m = 0;
+  for (size_t i = 0; i < a.size(); ++i) m = std::max(m, std::fabs(a[i] - b[i]));
+  return m;
 }
 
 }  // namespace
@@ -292,9 +303,14 @@ void LibraryCycle::start_planned_pose(const Eigen::Isometry3d& goal, bool holdin
 }
 
 void LibraryCycle::issue_plan() {
+  if (!motion_.planning) set_deadline(s_.plan_timeout_s);
   motion_.planning = true;
-  set_deadline(s_.plan_timeout_s);
-  if (!arm_) return;  // issued at the first arm state
+  motion_.plan_id = -1;
+  // A plan starts where the arm is: not from a moving arm (a visual servo's last commands, a
+  // stopped motion still coasting), whose state has changed by the time the trajectory arrives
+  // (the driver refuses a trajectory that does not start at the current state). Issued at the
+  // first arm state that is not EXECUTING (drive_motion), within the planning deadline.
+  if (!arm_ || arm_->state == kArmExecuting) return;
   CycleRequest r;
   r.kind = CycleRequest::Kind::kPlan;
   r.id = next_id();
@@ -303,6 +319,7 @@ void LibraryCycle::issue_plan() {
   r.goal_joints = motion_.goal_joints;
   r.pose = motion_.goal;
   r.start_joints = arm_->joints;
+  motion_.plan_start = arm_->joints;
   r.holding_book = motion_.holding;
   if (motion_.holding)
     r.book_size = Eigen::Vector3d(progress_.book_width, std::max(0.0, progress_.gp_grasp.x()), s_.held_book_depth_m);
@@ -955,6 +972,9 @@ std::vector<CycleRequest> LibraryCycle::on_plan(const PlanEvent& e) {
   if (motion_.kind == MotionKind::kPlanned && motion_.planning && e.request_id == motion_.plan_id) {
     if (!e.success) {
       fail("planning for " + cycle_state_name(state_) + " failed: " + e.message);
+    } else if (arm_ && max_joint_difference(arm_->joints, motion_.plan_start) > kPlanStartToleranceRad) {
+      // The arm moved while the plan was made: its trajectory no longer starts where the arm is.
+      issue_plan();
     } else {
       motion_.planning = false;
       motion_.executing = true;

@@ -265,6 +265,7 @@ class LibraryCycle {
     Eigen::Isometry3d goal = Eigen::Isometry3d::Identity();
     bool holding = false;
     int64_t plan_id = -1;
+    std::vector<double> plan_start;  ///< the joints the pending plan starts from
     int64_t command_id = -1;
     bool planning = false;
     bool executing = false;

@@ -75,6 +75,8 @@ class FakeLibrary {
   int missed_grasps = 0;                     ///< the gripper closes on nothing this many times
   bool servo_silent = false;                 ///< servo never answers (timeouts)
   bool user_answers = true;                  ///< sends "done" in WAIT_USER after 1 s
+  int arm_moves_during_planning = 0;         ///< the next N plans: the joints move 0.05 rad before the answer
+  int coast_after_servo_ticks = 0;           ///< after each servo answer the arm still EXECUTES this many ticks
 
   // ---- world ----
   std::deque<FakeBook> upper;
@@ -90,7 +92,10 @@ class FakeLibrary {
   int64_t active = 0;
   int64_t t = 1000000;
   std::vector<std::string> states;          ///< visited states, consecutive duplicates collapsed
+  std::vector<std::pair<std::string, Eigen::Vector3d>> tcp_path;  ///< state and TCP position every tick
   std::vector<CycleRequest> requests;       ///< every request seen
+  std::vector<int> arm_state_at_request;    ///< arm_state when each of `requests` was made
+  std::vector<double> joints = std::vector<double>(7, 0.0);  ///< reported joints
   std::vector<std::string> user_events_sent;
   std::optional<Eigen::Vector3d> ps;        ///< the fake arbiter's PS
 
@@ -98,6 +103,7 @@ class FakeLibrary {
   void tick(LibraryCycle& cycle) {
     t += 10000;
     integrate();
+    tcp_path.emplace_back(bookgrasp::cycle_state_name(cycle.state()), ee.translation());
     if ((t / 10000) % 10 == 0 || !markers_sent_) {
       bookgrasp::MarkersEvent m;
       m.utime = t;
@@ -108,13 +114,17 @@ class FakeLibrary {
     }
     bookgrasp::ArmEvent e;
     e.utime = t;
-    e.joints.assign(7, 0.0);
+    e.joints = joints;
     e.end_effector = ee;
     e.gripper_width = width;
     e.gripper_contact = contact;
     e.state = arm_state;
     e.active_command_id = active;
+    // Answers held back from earlier ticks reach the cycle after this arm state.
+    std::vector<std::function<std::vector<CycleRequest>()>> delayed;
+    delayed.swap(delayed_);
     handle(cycle, cycle.on_arm(e));
+    for (auto& d : delayed) handle(cycle, d());
     // The arbiter answers each stereo frame (5 Hz) while the cycle waits for a P1 check.
     if (cycle.state() == bookgrasp::CycleState::kWaitP1Check && (t / 10000) % 20 == 0)
       handle(cycle, cycle.on_decision(p1_check(0)));
@@ -152,6 +162,10 @@ class FakeLibrary {
   }
 
   void integrate() {
+    if (coast_until_ > 0 && t >= coast_until_) {
+      arm_state = 0;
+      coast_until_ = 0;
+    }
     if (arm_state == 1 && executing_plan_ && t >= plan_end_) {
       ee = plan_goal_;
       arm_state = 0;
@@ -190,6 +204,7 @@ class FakeLibrary {
     std::vector<std::function<std::vector<CycleRequest>()>> later;
     for (const CycleRequest& r : reqs) {
       requests.push_back(r);
+      arm_state_at_request.push_back(arm_state);
       const std::string state = bookgrasp::cycle_state_name(cycle.state());
       switch (r.kind) {
         case CycleRequest::Kind::kPlan: {
@@ -208,6 +223,12 @@ class FakeLibrary {
           } else {
             e.success = true;
             e.duration_s = 1.0;
+          }
+          if (arm_moves_during_planning > 0) {
+            --arm_moves_during_planning;
+            joints[3] += 0.05;
+            delayed_.push_back([&cycle, e] { return cycle.on_plan(e); });
+            break;
           }
           later.push_back([&cycle, e] { return cycle.on_plan(e); });
           break;
@@ -265,16 +286,24 @@ class FakeLibrary {
           break;
         case CycleRequest::Kind::kServo: {
           if (servo_silent) break;
+          // With coasting, the servo's answers arrive after an arm state that shows the arm moving.
+          auto& answers = coast_after_servo_ticks > 0 ? delayed_ : later;
+          if (coast_after_servo_ticks > 0) {
+            arm_state = 1;
+            executing_plan_ = false;
+            twist_.setZero();
+            coast_until_ = t + 10000 * coast_after_servo_ticks;
+          }
           bookgrasp::ServoEvent s;
           s.utime = t;
           s.request_id = r.id;
           s.mode = r.servo_mode;
           s.state = 2;  // CONVERGED
-          later.push_back([&cycle, s] { return cycle.on_servo(s); });
+          answers.push_back([&cycle, s] { return cycle.on_servo(s); });
           if (r.servo_mode == 2) {  // STRIPE_END: PS where the right-most book hides the stripe
             ps = Eigen::Vector3d(0.10, upper.empty() ? -0.395 : upper.front().right_y, -0.10);
             const bookgrasp::DecisionEvent d = p1_check(r.id);
-            later.push_back([&cycle, d] { return cycle.on_decision(d); });
+            answers.push_back([&cycle, d] { return cycle.on_decision(d); });
           } else {
             bookgrasp::DecisionEvent d;
             d.utime = t;
@@ -295,7 +324,7 @@ class FakeLibrary {
               d.gp_base.translation() = hand_grasp_frame() * d.gp_grasp;
             }
             d.reason = d.outcome + ": fake arbiter";
-            later.push_back([&cycle, d] { return cycle.on_decision(d); });
+            answers.push_back([&cycle, d] { return cycle.on_decision(d); });
           }
           break;
         }
@@ -316,6 +345,8 @@ class FakeLibrary {
   Eigen::Matrix<double, 6, 1> twist_ = Eigen::Matrix<double, 6, 1>::Zero();
   std::map<int64_t, Plan> plans_;
   int64_t wait_user_since_ = -1;
+  int64_t coast_until_ = 0;
+  std::vector<std::function<std::vector<CycleRequest>()>> delayed_;
 };
 
 }  // namespace bookgrasp_test

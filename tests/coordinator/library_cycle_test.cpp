@@ -378,6 +378,49 @@ TEST(LibraryCycle, ARestartDuringAServoWaitsUntilTheArmStaysStill) {
   EXPECT_EQ(w.lower.size(), 3u);
 }
 
+TEST(LibraryCycle, APlanIsNotRequestedWhileTheArmStillExecutes) {
+  // After a servo the arm may still move (its last velocity commands, a stop that coasts): a plan
+  // made from that state no longer starts where the arm is when the trajectory arrives, and the
+  // driver refuses it. The cycle waits for the arm to stop before it asks for a plan.
+  FakeLibrary w(three_books());
+  w.coast_after_servo_ticks = 30;
+  LibraryCycle c(settings(), std::nullopt);
+  w.run(c, [&] { return done_or_aborted(c); });
+  ASSERT_EQ(c.state(), CycleState::kDone) << c.status().message;
+  EXPECT_EQ(w.lower.size(), 3u);
+  int plans = 0, after_coast = 0;
+  for (size_t i = 0; i < w.requests.size(); ++i) {
+    if (w.requests[i].kind != CycleRequest::Kind::kPlan) continue;
+    ++plans;
+    EXPECT_NE(w.arm_state_at_request[i], 1) << "plan request " << w.requests[i].id << " while the arm executes";
+    after_coast += i > 0 && w.requests[i - 1].kind != CycleRequest::Kind::kPlan;
+  }
+  EXPECT_GT(plans, 6);
+  EXPECT_GT(after_coast, 0);
+}
+
+TEST(LibraryCycle, APlanWhoseStartTheArmLeftWhilePlanningIsMadeAgain) {
+  FakeLibrary w(three_books());
+  w.arm_moves_during_planning = 1;
+  LibraryCycle c(settings(), std::nullopt);
+  w.run(c, [&] { return done_or_aborted(c); });
+  ASSERT_EQ(c.state(), CycleState::kDone) << c.status().message;
+  EXPECT_EQ(w.lower.size(), 3u);
+  std::vector<CycleRequest> plans;
+  std::vector<int64_t> executed;
+  for (const CycleRequest& r : w.requests) {
+    if (r.kind == CycleRequest::Kind::kPlan) plans.push_back(r);
+    if (r.kind == CycleRequest::Kind::kExecutePlan) executed.push_back(r.plan_id);
+  }
+  ASSERT_GE(plans.size(), 2u);
+  // The first plan started at joint 4 = 0 and the arm moved to 0.05: never executed; the next one
+  // starts from where the arm is and is.
+  EXPECT_DOUBLE_EQ(plans[0].start_joints[3], 0.0);
+  EXPECT_DOUBLE_EQ(plans[1].start_joints[3], 0.05);
+  EXPECT_EQ(std::count(executed.begin(), executed.end(), plans[0].id), 0);
+  EXPECT_EQ(std::count(executed.begin(), executed.end(), plans[1].id), 1);
+}
+
 TEST(LibraryCycle, ResumeWithABookExpectedInTheGripperButNoContactAborts) {
   FakeLibrary w(three_books());
   LibraryCycle first(settings(), std::nullopt);
