@@ -1,6 +1,7 @@
 #pragma once
 /// @file
-/// Caption lines on debug pictures: readable on any background (outlined in black).
+/// Caption lines on debug pictures: readable on any background (outlined in black),
+/// wrapped at the image's right edge.
 
 #include <string>
 
@@ -8,8 +9,9 @@
 
 namespace bookgrasp {
 
-/// Writes `text` as caption line `line` (0 = top) in the top-left corner of an 8-bit
-/// 3-channel image, in `colour` outlined in black.
-void draw_caption_line(cv::Mat* image, int line, const std::string& text, const cv::Scalar& colour);
+/// Writes `text` from caption line `line` (0 = top) in the top-left corner of an 8-bit
+/// 3-channel image, in `colour` outlined in black, wrapped at spaces onto further lines when
+/// it is wider than the image. Returns the line after the last one written.
+int draw_caption(cv::Mat* image, int line, const std::string& text, const cv::Scalar& colour);
 
 }  // namespace bookgrasp

@@ -29,13 +29,13 @@ cv::Mat draw_bswh_overlay(const cv::Mat& image, const StripeDetection& d, const 
   if (d.end_found) cv::drawMarker(img, d.end, cv::Scalar(255, 40, 40), cv::MARKER_CROSS, 16, 2, cv::LINE_AA);
   std::snprintf(buf, sizeof buf, "%s: stripe %s, end %s", title.c_str(), d.found ? "found" : "not found",
                 d.end_found ? "found" : "not found");
-  draw_caption_line(&img, 0, buf, cv::Scalar(255, 255, 255));
+  const int next = draw_caption(&img, 0, buf, cv::Scalar(255, 255, 255));
   if (d.end_found) {
     std::snprintf(buf, sizeof buf, "end (%.1f, %.1f) px, angle %.2f deg, thickness %.1f px, edge rows %d", d.end.x,
                   d.end.y, d.angle_rad * 180.0 / CV_PI, d.thickness_px, d.end_edge_support);
-    draw_caption_line(&img, 1, buf, cv::Scalar(255, 80, 80));
+    draw_caption(&img, next, buf, cv::Scalar(255, 80, 80));
   } else {
-    draw_caption_line(&img, 1, d.failure_reason, cv::Scalar(255, 80, 80));
+    draw_caption(&img, next, d.failure_reason, cv::Scalar(255, 80, 80));
   }
   return img;
 }

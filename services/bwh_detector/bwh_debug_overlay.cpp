@@ -38,15 +38,15 @@ cv::Mat draw_bwh_overlay(const cv::Mat& image, const BookDetection& d, int rank_
   for (const BookCandidate& c : d.candidates) accepted += c.accepted;
   std::snprintf(buf, sizeof buf, "%s: %zu candidates, %d books (green), rank %d red", title.c_str(),
                 d.candidates.size(), accepted, rank_from_right);
-  draw_caption_line(&img, 0, buf, cv::Scalar(255, 255, 255));
+  const int next = draw_caption(&img, 0, buf, cv::Scalar(255, 255, 255));
   if (selected >= 0) {
     const BookCandidate& b = d.candidates[static_cast<size_t>(selected)];
     std::snprintf(buf, sizeof buf, "R (%.1f, %.1f) px, slope %.2f deg, width %.1f px%s", b.corner_r.x, b.corner_r.y,
                   b.slope_rad * 180.0 / CV_PI, b.width_px, b.refined ? "" : " (outline, not refined)");
-    draw_caption_line(&img, 1, buf, cv::Scalar(255, 80, 80));
+    draw_caption(&img, next, buf, cv::Scalar(255, 80, 80));
   } else {
-    draw_caption_line(&img, 1, "no book: " + (d.found ? "rank beyond the books found" : d.failure_reason),
-                      cv::Scalar(255, 80, 80));
+    draw_caption(&img, next, "no book: " + (d.found ? "rank beyond the books found" : d.failure_reason),
+                 cv::Scalar(255, 80, 80));
   }
   return img;
 }

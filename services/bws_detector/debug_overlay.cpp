@@ -42,7 +42,7 @@ cv::Mat draw_bws_overlay(const cv::Mat& left, const BwsOutput& r, const std::str
   }
   char buf[256];
   int line = 0;
-  const auto text = [&](const std::string& s, const cv::Scalar& colour) { draw_caption_line(&img, line++, s, colour); };
+  const auto text = [&](const std::string& s, const cv::Scalar& colour) { line = draw_caption(&img, line, s, colour); };
   int candidates = 0;
   for (const RegionVerdict& v : r.selection.regions) candidates += v.candidate;
   std::snprintf(buf, sizeof buf, "%s: %zu regions, %d candidates (green), selected red", title.c_str(), K, candidates);

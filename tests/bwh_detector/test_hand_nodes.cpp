@@ -1,6 +1,7 @@
 // Tests of the bwh_detector and bswh_detector components on an in-process bus:
 // outputs against the synthetic truth, utime, rank requests, bad images, shipped configs.
 #include <cmath>
+#include <cstdlib>
 #include <map>
 #include <regex>
 #include <vector>
@@ -175,6 +176,7 @@ TEST(HandNodesDebug, DebugImagesShowRAndTheStripeEndOnlyWhenEnabled) {
   ASSERT_EQ(got["BSWH_DEBUG_IMAGE"].size(), 1u);
   for (const auto& [channel, images] : got) {
     const image_t& im = images[0];
+    if (const char* dir = std::getenv("BOOKGRASP_DEBUG_IMAGES")) write_png(std::string(dir) + "/" + channel + ".png", image_to_mat(im));
     EXPECT_EQ(im.utime, 4242) << channel;
     EXPECT_EQ(im.pixel_format, image_t::PNG) << channel;
     EXPECT_EQ(im.frame, "hand_camera") << channel;

@@ -55,6 +55,17 @@ TEST(Config, WrongTypeAndRangeAndChoice) {
   EXPECT_NE(error_of([&] { c.child("service.name"); }).find("mapping"), std::string::npos);
 }
 
+TEST(Config, ChannelNamesMustBeNonEmptyWithoutSpaces) {
+  const Config c = Config::from_string("channels: {a: STEREO_IMAGES, b: \"\", c: \"MY CH\"}", "ch.yaml");
+  EXPECT_EQ(c.get_channel("channels.a"), "STEREO_IMAGES");
+  const std::string empty = error_of([&] { c.get_channel("channels.b"); });
+  EXPECT_NE(empty.find("channels.b"), std::string::npos) << empty;
+  EXPECT_NE(empty.find("must not be empty"), std::string::npos) << empty;
+  const std::string spaced = error_of([&] { c.get_channel("channels.c"); });
+  EXPECT_NE(spaced.find("no spaces"), std::string::npos) << spaced;
+  EXPECT_NE(error_of([&] { c.get_channel("channels.d"); }).find("missing"), std::string::npos);
+}
+
 TEST(Config, NonFiniteNumbersRejected) {
   const Config c = Config::from_string("a: .nan\nb: .inf\n", "nan.yaml");
   EXPECT_NE(error_of([&] { c.get<double>("a"); }).find("finite"), std::string::npos);
