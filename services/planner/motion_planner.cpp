@@ -1,5 +1,6 @@
 #include "services/planner/motion_planner.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <memory>
@@ -229,10 +230,31 @@ PlanOutcome MotionPlanner::plan(const PlanningScene& scene, const PlanRequest& r
   const Eigen::Matrix3d kept = start_tip.linear();
   const double band = req.orientation_tolerance_rad;
   const bool keep = req.keep_orientation;
-  const StateCheck valid = [&scene, &kin, keep, kept, band](const Eigen::VectorXd& q) {
-    if (keep && rotation_angle(kin.tip_pose(q).linear(), kept) > band) return false;
+  if (!(req.max_tool_tilt_rad >= 0) || !std::isfinite(req.max_tool_tilt_rad))
+    return fail(PlanFailure::kInvalidRequest, "max_tool_tilt_rad must be finite and >= 0");
+  const double min_up = req.max_tool_tilt_rad > 0 ? std::cos(req.max_tool_tilt_rad) : -2.0;
+  // Tilt of the tool's x axis from base +z (cosine = its z component).
+  const auto tilt_of = [](const Eigen::Matrix3d& r) { return std::acos(std::clamp(r(2, 0), -1.0, 1.0)); };
+  const StateCheck valid = [&scene, &kin, keep, kept, band, min_up](const Eigen::VectorXd& q) {
+    if (keep || min_up > -1.5) {
+      const Eigen::Matrix3d r = kin.tip_pose(q).linear();
+      if (keep && rotation_angle(r, kept) > band) return false;
+      if (r(2, 0) < min_up) return false;
+    }
     return scene.is_valid(q);
   };
+  if (req.max_tool_tilt_rad > 0) {
+    if (tilt_of(start_tip.linear()) > req.max_tool_tilt_rad)
+      return fail(PlanFailure::kInvalidRequest,
+                  "the start tilts the tool's x axis " + fmt(tilt_of(start_tip.linear())) +
+                      " rad from upright, more than max_tool_tilt_rad " + fmt(req.max_tool_tilt_rad));
+    const Eigen::Matrix3d goal_r = req.goal_is_pose ? Eigen::Matrix3d(req.goal_pose.linear())
+                                                    : Eigen::Matrix3d(kin.tip_pose(req.goal_joints).linear());
+    if (tilt_of(goal_r) > req.max_tool_tilt_rad)
+      return fail(PlanFailure::kInvalidRequest, "the goal tilts the tool's x axis " + fmt(tilt_of(goal_r)) +
+                                                    " rad from upright, more than max_tool_tilt_rad " +
+                                                    fmt(req.max_tool_tilt_rad));
+  }
   const CollisionReport start_report = scene.check(start);
   if (start_report.collision)
     return fail(PlanFailure::kStartInCollision, "start is in collision: " + start_report.describe() +
@@ -256,6 +278,7 @@ PlanOutcome MotionPlanner::plan(const PlanningScene& scene, const PlanRequest& r
     int ik_ok = 0;
     std::string ik_reason, collision;
     Eigen::VectorXd closest;  // failed attempt that came closest: later seeds also perturb it
+    std::vector<Eigen::VectorXd> near_limit_goals;  // valid, but within goal_limit_margin_rad of a joint limit
     double closest_error = INFINITY;
     for (int attempt = 0; attempt < params_.goal_ik_attempts &&
                           static_cast<int>(goals.size()) < params_.goal_ik_solutions; ++attempt) {
@@ -286,10 +309,15 @@ PlanOutcome MotionPlanner::plan(const PlanningScene& scene, const PlanRequest& r
         if (collision.empty()) collision = c.describe();
         continue;
       }
+      // A goal at a joint's limit leaves the straight moves that follow it no room (the arm driver stops a
+      // Cartesian motion at a limit): such goals are used only when there is no other.
+      const bool near_limit = !kin.within_limits(r.q, -params_.goal_limit_margin_rad);
+      std::vector<Eigen::VectorXd>& list = near_limit ? near_limit_goals : goals;
       bool distinct = true;
-      for (const auto& g : goals) distinct = distinct && (g - r.q).norm() > 0.1;
-      if (distinct) goals.push_back(r.q);
+      for (const auto& g : list) distinct = distinct && (g - r.q).norm() > 0.1;
+      if (distinct) list.push_back(r.q);
     }
+    if (goals.empty()) goals = near_limit_goals;
     if (ik_ok == 0)
       return fail(PlanFailure::kNoIk, "no IK solution for the goal pose after " +
                                           std::to_string(params_.goal_ik_attempts) + " attempts (" + ik_reason + ")");

@@ -42,6 +42,9 @@ struct PlanRequest {
   double position_tolerance_m = 0.001;    ///< pose goal: accepted position error
   double orientation_tolerance_rad = 0.01;///< pose goal error; also the band of keep_orientation
   bool keep_orientation = false;          ///< keep the tool orientation of the start along the path
+  /// > 0: along the whole path the tool's x axis stays within this angle of base +z (a held book, whose
+  /// up is the gripper's x, stays upright); start and goal must meet it. 0 = no such constraint.
+  double max_tool_tilt_rad = 0.0;
   double time_budget_s = 1.0;             ///< planning time limit (wall clock)
   std::string planner;                    ///< "CellBiRRT", "RRTConnect", "BiTRRT"; "" = default
   uint64_t seed = 1;                      ///< random seed (same request + seed -> same path)
@@ -71,6 +74,7 @@ struct MotionPlannerParams {
   int simplify_shortcuts = 60;             ///< random shortcut attempts
   int goal_ik_solutions = 4;               ///< distinct valid IK solutions used as goals for a pose goal
   int goal_ik_attempts = 24;               ///< IK attempts to find them
+  double goal_limit_margin_rad = 0.0;      ///< goal IK solutions this close to a joint limit are a last resort
   Eigen::VectorXd max_velocity;            ///< rad/s per joint (trajectory)
   Eigen::VectorXd max_acceleration;        ///< rad/s^2 per joint (trajectory)
   double sample_period_s = 0.02;           ///< trajectory sample period

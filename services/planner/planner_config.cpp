@@ -1,5 +1,6 @@
 #include "services/planner/planner_config.h"
 
+#include <cmath>
 #include <sstream>
 
 #include "common/version.h"
@@ -73,6 +74,7 @@ PlannerSettings PlannerSettings::from_config(const Config& root) {
       throw ConfigError(root.source() + ": " + hb.path_of("touch_links") + " names '" + l + "', not a robot link");
   s.held_book.top_above_tcp_m = hb.get_double("top_above_tcp_m", -0.5, 0.5);
   s.held_book.behind_tcp_m = hb.get_double("behind_tcp_m", -0.5, 0.5);
+  s.held_book.max_tilt_rad = hb.get_double("max_tilt_deg", 0.0, 90.0) * M_PI / 180.0;
 
   const Config pl = root.child("planner");
   MotionPlannerParams& p = s.planner;
@@ -84,6 +86,7 @@ PlannerSettings PlannerSettings::from_config(const Config& root) {
   p.simplify_shortcuts = pl.get_int("simplify_shortcuts", 0, 100000);
   p.goal_ik_solutions = pl.get_int("goal_ik_solutions", 1, 100);
   p.goal_ik_attempts = pl.get_int("goal_ik_attempts", 1, 10000);
+  p.goal_limit_margin_rad = pl.get_double("goal_limit_margin_rad", 0.0, 1.0);
   p.max_velocity = vecn(pl, "max_velocity_rad_s", n);
   p.max_acceleration = vecn(pl, "max_acceleration_rad_s2", n);
   for (size_t k = 0; k < n; ++k) {

@@ -20,6 +20,7 @@ struct HeldBookParams {
   std::vector<std::string> touch_links;  ///< links the book may touch
   double top_above_tcp_m = 0.015;        ///< book top above the TCP (gripper +x)
   double behind_tcp_m = 0.03;            ///< fore-edge behind the TCP (gripper -z)
+  double max_tilt_rad = 0.0;             ///< > 0: a planned path keeps the book (gripper x) this upright
 };
 
 /// The whole planner configuration, validated.
