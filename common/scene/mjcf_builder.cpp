@@ -178,7 +178,7 @@ MjcfDocument build_mjcf(const Scene& s) {
   x << "<mujoco model=\"bookgrasp_" << s.name << "_" << s.seed << "\">\n";
   x << "  <compiler angle=\"radian\" inertiafromgeom=\"auto\"/>\n";
   x << "  <option timestep=\"" << num(ph.timestep_s) << "\" cone=\"elliptic\" impratio=\"" << num(ph.impratio)
-    << "\" integrator=\"implicit\"/>\n";
+    << "\" integrator=\"implicit\" noslip_iterations=\"" << ph.noslip_iterations << "\"/>\n";
   // njmax sizes dense njmax x njmax buffers in mjData (8000 would memset 0.5 GB): ~40 contacts need ~200 rows.
   x << "  <size nconmax=\"600\" njmax=\"2000\"/>\n";
   // Fixed statistic: znear/zfar and shadow clipping scale with the extent; keep them independent of the books.

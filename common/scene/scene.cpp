@@ -443,6 +443,7 @@ Scene generate_scene(const Config& root, uint64_t seed, const std::string& base_
     Physics& p = s.physics;
     p.timestep_s = c.get_double("timestep_s", 1e-4, 0.01);
     p.impratio = c.get_double("impratio", 1, 1000);
+    p.noslip_iterations = c.has("noslip_iterations") ? c.get_int("noslip_iterations", 0, 1000) : 0;
     p.settle_time_s = c.get_double("settle_time_s", 0, 10);
     p.arm_kp = c.get_vector("arm_kp", 7);
     p.arm_damping = c.get_vector("arm_damping", 7);

@@ -90,6 +90,7 @@ struct CameraSpec {
 struct Physics {
   double timestep_s = 0.002;
   double impratio = 10;
+  int noslip_iterations = 0;        ///< MuJoCo's no-slip solver passes (0 = off): no creep of held books
   double settle_time_s = 0.5;       ///< physics run at build so books come to rest
   std::vector<double> arm_kp;       ///< position gain per arm joint (Nm/rad)
   std::vector<double> arm_damping;  ///< joint damping per arm joint (Nm s/rad)
