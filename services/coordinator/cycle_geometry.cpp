@@ -47,6 +47,7 @@ CycleGeometry CycleGeometry::from_config(const Config& c) {
   g.holder_gripper_axes.col(1) = y;
   g.holder_gripper_axes.col(2) = x.cross(y);
   g.holder_pre_place_offset = vec3(c, "holder.pre_place_offset_m", 1.0);
+  g.holder_place_descent = c.get_double("holder.place_descent_m", 0.0, 0.5);
   g.holder_retreat = c.get_double("holder.retreat_m", 0.02, 0.6);
   g.lower_drop = c.get_double("lower_shelf.drop_m", 0.1, 1.5);
   g.lower_front_z = c.get_double("lower_shelf.front_z_m", -0.2, 0.5);
@@ -121,6 +122,21 @@ Eigen::Isometry3d holder_pre_place_pose(const Eigen::Isometry3d& s, double h, co
   Eigen::Isometry3d p = holder_place_pose(s, h, g);
   p.translation() += s.linear() * g.holder_pre_place_offset;
   return p;
+}
+
+std::vector<Eigen::Isometry3d> holder_place_moves(const Eigen::Isometry3d& s, double h, const CycleGeometry& g) {
+  const Eigen::Isometry3d place = holder_place_pose(s, h, g);
+  if (!(g.holder_place_descent > 0)) return {place};
+  Eigen::Isometry3d above = place;
+  above.translation() += s.linear().col(2) * g.holder_place_descent;
+  return {above, place};
+}
+
+std::vector<Eigen::Isometry3d> holder_lift_moves(const Eigen::Isometry3d& s, double h, const CycleGeometry& g) {
+  std::vector<Eigen::Isometry3d> moves = holder_place_moves(s, h, g);
+  moves.pop_back();  // from the place pose: up first (if a descent is configured), then to the pre-place pose
+  moves.push_back(holder_pre_place_pose(s, h, g));
+  return moves;
 }
 
 Eigen::Isometry3d lower_place_pose(const Eigen::Isometry3d& f, double right_y, double bw, double h,

@@ -11,6 +11,8 @@
 /// the back plate, y left along it, z up along it. Marker poses follow the
 /// AprilTag convention of MARKERS (x right, y down, z into the tag).
 
+#include <vector>
+
 #include <Eigen/Geometry>
 
 #include "common/config.h"
@@ -40,6 +42,7 @@ struct CycleGeometry {
   Eigen::Vector3d holder_place_tcp = Eigen::Vector3d::Zero();  ///< TCP in support; z gets the book height added
   Eigen::Matrix3d holder_gripper_axes = Eigen::Matrix3d::Identity();  ///< gripper axes in support (columns)
   Eigen::Vector3d holder_pre_place_offset = Eigen::Vector3d::Zero();  ///< pre-place = place + this (support)
+  double holder_place_descent = 0.0;  ///< > 0: the place ends straight down the support's z from this far above
   double holder_retreat = 0.10;     ///< after release, out along the gripper -z
   // lower shelf
   double lower_drop = 0.35;         ///< lower shelf surface below the upper one
@@ -77,6 +80,13 @@ double tcp_height_on_book(const Eigen::Vector3d& gp_grasp, const CycleGeometry& 
 Eigen::Isometry3d holder_place_pose(const Eigen::Isometry3d& support, double tcp_height, const CycleGeometry& g);
 /// Pre-place pose on the holder.
 Eigen::Isometry3d holder_pre_place_pose(const Eigen::Isometry3d& support, double tcp_height, const CycleGeometry& g);
+/// The straight moves from the pre-place pose that put the book on the holder: over the place pose at
+/// `holder_place_descent` (if > 0), then down along the support's z to the place pose.
+std::vector<Eigen::Isometry3d> holder_place_moves(const Eigen::Isometry3d& support, double tcp_height,
+                                                  const CycleGeometry& g);
+/// The straight moves that lift a book grasped on the holder back to the pre-place pose (the reverse).
+std::vector<Eigen::Isometry3d> holder_lift_moves(const Eigen::Isometry3d& support, double tcp_height,
+                                                 const CycleGeometry& g);
 /// TCP pose that stands the held book on the lower shelf with its right cover at grasp Y `right_y`.
 Eigen::Isometry3d lower_place_pose(const Eigen::Isometry3d& grasp_frame, double right_y, double book_width,
                                    double tcp_height, const CycleGeometry& g);

@@ -675,6 +675,8 @@ void LibraryCycle::enter(CycleState s) {
       start_planned_pose(holder_pre_place_pose(holder_frame(), tcp_height(), g), true);
       break;
     case CycleState::kPlaceOnHolder:
+      start_linear(holder_place_moves(holder_frame(), tcp_height(), g));
+      break;
     case CycleState::kApproachHolder:
       start_linear({holder_place_pose(holder_frame(), tcp_height(), g)});
       break;
@@ -692,7 +694,7 @@ void LibraryCycle::enter(CycleState s) {
                          false);
       break;
     case CycleState::kLiftFromHolder:
-      start_linear({holder_pre_place_pose(holder_frame(), tcp_height(), g)});
+      start_linear(holder_lift_moves(holder_frame(), tcp_height(), g));
       break;
     case CycleState::kMoveToLowerShelf: {
       const double left_after = progress_.lower_next_right_y - progress_.book_width;
