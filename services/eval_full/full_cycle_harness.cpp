@@ -1,5 +1,6 @@
 #include "services/eval_full/full_cycle_harness.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -9,6 +10,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include <mujoco/mujoco.h>
 #include <yaml-cpp/yaml.h>
 #include <lcm/lcm-cpp.hpp>
 #include <opencv2/imgcodecs.hpp>
@@ -372,6 +374,33 @@ struct FullCycleHarness::Impl {
       }
       target_book_id = b.truth_id;
     }
+    if (prev == "RELEASE_ON_HOLDER") {
+      // The coordinator believes the book is on the holder now; physics decides.
+      BookRecord& b = book(m->current_book);
+      const book_truth_t* tb = truth_book(now_truth, b.truth_id);
+      b.place_after_holder_release = tb ? tb->place : std::string("unknown");
+      ++res.holder_releases;
+      if (b.place_after_holder_release == "holder") ++res.holder_placed;
+      trace(std::string("HOLDER ") + (b.place_after_holder_release == "holder" ? "placed" : "NOT PLACED") +
+            ": book id " + std::to_string(b.truth_id) + " is " + b.place_after_holder_release);
+    }
+    if (prev == "RETREAT_FROM_HOLDER") {
+      BookRecord& b = book(m->current_book);
+      const book_truth_t* tb = truth_book(now_truth, b.truth_id);
+      double lowest = 1e9, up = -1;
+      if (tb) {
+        const Eigen::Isometry3d inv = scene.holder_support_pose.inverse();
+        for (const auto& c : tb->corners_base) lowest = std::min(lowest, (inv * vec3(c)).z());
+        const Eigen::Isometry3d pose = pose_to_isometry(tb->pose);
+        up = pose.linear().col(2).dot(scene.holder_support_pose.linear().col(2));
+      }
+      const bool standing = tb && tb->place == "holder" && std::abs(lowest) <= 0.02 && up >= std::cos(35 * M_PI / 180);
+      b.standing_on_holder = standing ? 1 : 0;
+      if (standing) ++res.holder_standing;
+      trace(std::string("HOLDER ") + (standing ? "standing" : "NOT STANDING") + ": book id " +
+            std::to_string(b.truth_id) + fmt(" lowest corner %.3f m above the ledge,", lowest) +
+            fmt(" up %.0f deg from the back plate's", std::acos(std::clamp(up, -1.0, 1.0)) * 180 / M_PI));
+    }
     if (m->state == "CLOSE_GRIPPER") {
       BookRecord& b = book(m->current_book);
       ++b.grasp_attempts;
@@ -393,7 +422,46 @@ struct FullCycleHarness::Impl {
       in_extract = false;  // the close itself failed (nothing grasped); counted as a failed attempt
       trace("GRASP FAILED at close: " + m->message);
     }
+    if (o.verbose && target_book_id >= 0) grip_diag();
     snapshot(m->state);
+  }
+
+  /// Verbose: where the TCP is on the target book (book body frame: x depth, y width, z height).
+  void grip_diag() {
+    const auto& model = sim->world().model();
+    const mjModel* mm = model.model();
+    const mjData* dd = model.data();
+    const int body = mj_name2id(mm, mjOBJ_BODY, ("book_" + std::to_string(target_book_id)).c_str());
+    const int site = mj_name2id(mm, mjOBJ_SITE, "gripper");
+    if (body < 0 || site < 0) return;
+    Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < 3; ++c) pose.linear()(r, c) = dd->xmat[9 * body + 3 * r + c];
+    pose.translation() = Eigen::Vector3d(dd->xpos[3 * body], dd->xpos[3 * body + 1], dd->xpos[3 * body + 2]);
+    const Eigen::Vector3d tcp(dd->site_xpos[3 * site], dd->site_xpos[3 * site + 1], dd->site_xpos[3 * site + 2]);
+    const Eigen::Vector3d in_book = pose.inverse() * tcp;
+    const Eigen::Vector3d in_cart = scene.cart_pose.inverse() * tcp;
+    double h = 0, d = 0;
+    for (const auto& bk : scene.books)
+      if (bk.id == target_book_id) h = bk.height_m, d = bk.depth_m;
+    // The book's rotation in the gripper from the grasp's (book x = gripper z, y = -y, z = x), gripper axes, deg.
+    Eigen::Matrix3d g;
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < 3; ++c) g(r, c) = dd->site_xmat[9 * site + 3 * r + c];
+    Eigen::Matrix3d nominal;
+    nominal.col(0) = Eigen::Vector3d::UnitZ();
+    nominal.col(1) = -Eigen::Vector3d::UnitY();
+    nominal.col(2) = Eigen::Vector3d::UnitX();
+    const Eigen::AngleAxisd aa(g.transpose() * pose.linear() * nominal.transpose());
+    const Eigen::Vector3d rv = aa.axis() * aa.angle() * 180 / M_PI;
+    char l[400];
+    std::snprintf(l, sizeof l,
+                  "GRIP_DIAG book %d (h %.3f d %.3f): TCP above the book's bottom %.4f, behind its fore-edge %.4f, "
+                  "off its middle %.4f; TCP above the upper shelf %.4f; book up-axis z %.3f; book turned in the "
+                  "plates about the gripper's x/y/z %.1f %.1f %.1f deg",
+                  target_book_id, h, d, in_book.z() + h / 2, in_book.x() + d / 2, in_book.y(), in_cart.z(),
+                  pose.linear()(2, 2), rv.x(), rv.y(), rv.z());
+    trace(l);
   }
 
   void on_gp(const lcm::ReceiveBuffer*, const std::string&, const grasp_point_t* m) {
@@ -449,12 +517,68 @@ struct FullCycleHarness::Impl {
     }
   }
 
+  /// Verbose: the held book against the holder (true support frame) while it is placed.
+  int64_t last_holder_diag = 0;
+  void holder_diag() {
+    const auto& model = sim->world().model();
+    const mjModel* mm = model.model();
+    const mjData* dd = model.data();
+    const int body = mj_name2id(mm, mjOBJ_BODY, ("book_" + std::to_string(target_book_id)).c_str());
+    const int site = mj_name2id(mm, mjOBJ_SITE, "gripper");
+    if (body < 0 || site < 0) return;
+    const Eigen::Isometry3d inv = scene.holder_support_pose.inverse();
+    const Eigen::Vector3d b = inv * Eigen::Vector3d(dd->xpos[3 * body], dd->xpos[3 * body + 1], dd->xpos[3 * body + 2]);
+    const Eigen::Vector3d tcp =
+        inv * Eigen::Vector3d(dd->site_xpos[3 * site], dd->site_xpos[3 * site + 1], dd->site_xpos[3 * site + 2]);
+    Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < 3; ++c) pose.linear()(r, c) = dd->xmat[9 * body + 3 * r + c];
+    pose.translation() = Eigen::Vector3d(dd->xpos[3 * body], dd->xpos[3 * body + 1], dd->xpos[3 * body + 2]);
+    Eigen::Vector3d lo = Eigen::Vector3d::Constant(1e9), hi = Eigen::Vector3d::Constant(-1e9);
+    for (const auto& bk : scene.books)
+      if (bk.id == target_book_id)
+        for (const auto& c : scene::book_corners(pose, bk.width_m, bk.height_m, bk.depth_m)) {
+          lo = lo.cwiseMin(inv * c);
+          hi = hi.cwiseMax(inv * c);
+        }
+    // The book's extent in the support frame, then what it touches.
+    std::string contacts = fmt(" extent x [%.3f", lo.x()) + fmt(" %.3f]", hi.x()) + fmt(" y [%.3f", lo.y()) +
+                           fmt(" %.3f]", hi.y()) + fmt(" z [%.3f", lo.z()) + fmt(" %.3f]; contacts:", hi.z());
+    for (int i = 0; i < dd->ncon; ++i) {
+      const mjContact& c = dd->contact[i];
+      const int b1 = mm->geom_bodyid[c.geom1], b2 = mm->geom_bodyid[c.geom2];
+      if (b1 != body && b2 != body) continue;
+      const int other = b1 == body ? c.geom2 : c.geom1;
+      const char* n = mj_id2name(mm, mjOBJ_GEOM, other);
+      contacts += std::string(" ") + (n ? n : "?") + fmt("(%.4f)", c.dist);
+    }
+    char l[400];
+    std::snprintf(l, sizeof l,
+                  "HOLDER_DIAG %s book id %d centre in support (%.3f %.3f %.3f) tcp (%.3f %.3f %.3f) width %.4f "
+                  "gripper x/y/z up %.2f %.2f %.2f;",
+                  status.state.c_str(), target_book_id, b.x(), b.y(), b.z(), tcp.x(), tcp.y(), tcp.z(),
+                  model.gripper_width(), dd->site_xmat[9 * site + 6], dd->site_xmat[9 * site + 7],
+                  dd->site_xmat[9 * site + 8]);
+    trace(l + contacts);
+  }
+
   int64_t last_periodic = 0;
   std::string last_end;
   void step() {
     t += step_us;
     sim->advance_to(t);
     comp.spin();
+    if (o.verbose && (status.state == "PLACE_ON_HOLDER" || status.state == "RELEASE_ON_HOLDER") &&
+        t - last_holder_diag >= 200000) {
+      last_holder_diag = t;
+      holder_diag();
+    }
+    // The held book turning in the plates (MuJoCo's soft friction lets it creep about the finger axis).
+    if (o.verbose && target_book_id >= 0 && (status.state == "EXTRACT" || status.state == "MOVE_TO_HOLDER") &&
+        t - last_holder_diag >= 1000000) {
+      last_holder_diag = t;
+      grip_diag();
+    }
     if (o.snapshot_period_s > 0 && (status.state == "SERVO_STRIPE" || status.state == "SERVO_BOOK") &&
         t - last_periodic >= static_cast<int64_t>(o.snapshot_period_s * 1e6)) {
       last_periodic = t;

@@ -46,7 +46,8 @@ struct FullCycleOptions {
   bool log_images = false;           ///< also log STEREO_IMAGES and HAND_IMAGE (large)
   std::string snapshot_dir;          ///< "" = none; else PNGs of the stereo/hand images at state changes
   double snapshot_period_s = 0;      ///< > 0: also a hand snapshot this often while a servo runs
-  bool verbose = false;              ///< trace lines to stderr as they happen
+  bool verbose = false;              ///< trace lines to stderr as they happen; also GRIP_DIAG (the target book
+                                     ///< in the plates, truth) and HOLDER_DIAG (the book against the holder) lines
   /// Extra configuration overrides "service:dotted.key=value" (value parsed as YAML), applied
   /// after the harness's own; the key must exist in the service's YAML.
   std::vector<std::string> overrides;
@@ -73,6 +74,13 @@ struct BookRecord {
   int grasp_attempts = 0;            ///< CLOSE_GRIPPER entries for this book (from the shelf)
   int grasp_successes = 0;           ///< ... after which the book was in the gripper (physics)
   bool moved = false;                ///< completed the whole cycle (on the lower shelf)
+  /// SIM_GROUND_TRUTH place of the book when the coordinator left RELEASE_ON_HOLDER ("" = it never did):
+  /// "holder" = the book was put on the holder; anything else = lost on the way or while placing.
+  std::string place_after_holder_release;
+  /// When the coordinator left RETREAT_FROM_HOLDER (the gripper away): 1 = the book stands on the holder's
+  /// ledge (truth: lowest corner within 2 cm of the ledge, its up within 35 deg of the back plate's), 0 = it
+  /// does not (fell over, lies on the base, ...), -1 = not reached.
+  int standing_on_holder = -1;
   double start_s = 0;                ///< message time the book's attempt started (s from start)
   double end_s = -1;                 ///< message time it was counted moved
 };
@@ -85,6 +93,9 @@ struct FullCycleResult {
   int books_moved = 0;               ///< coordinator's count
   int grasp_attempts = 0;
   int grasp_successes = 0;
+  int holder_releases = 0;  ///< RELEASE_ON_HOLDER left (the coordinator thinks the book is on the holder)
+  int holder_placed = 0;    ///< ... with the book's truth place "holder"
+  int holder_standing = 0;  ///< books standing on the holder's ledge after RETREAT_FROM_HOLDER (truth)
   std::vector<BookRecord> books;
   std::vector<GraspDecisionRecord> decisions;
   ground_truth_t final_truth;        ///< latest SIM_GROUND_TRUTH

@@ -38,6 +38,12 @@ std::string first_words(const std::string& msg, int words) {
 
 std::string failure_reason(const FullCycleResult& r, int max_books) {
   if (r.end == "ERROR") return "ERROR: " + r.message;
+  for (const auto& b : r.books)
+    if (!b.place_after_holder_release.empty() && b.place_after_holder_release != "holder")
+      return "BOOK_NOT_ON_HOLDER after RELEASE_ON_HOLDER: the book is " + b.place_after_holder_release +
+             (b.grasp_successes == 0 ? " (it was not in the plates after EXTRACT)" : "");
+  for (const auto& b : r.books)
+    if (b.standing_on_holder == 0) return "BOOK_NOT_STANDING_ON_HOLDER after RETREAT_FROM_HOLDER";
   if (r.end == "ABORTED") {
     // "aborted in STATE: book 0: 3 attempts failed (...), last: <cause>": class = state + cause.
     const auto in = r.message.find("aborted in ");
@@ -84,6 +90,10 @@ void accumulate(const SceneOutcome& o, int max_books, const MetricTolerances& to
   m->books_moved += std::min(r.books_moved, targeted > 0 ? targeted : r.books_moved);
   m->grasp_attempts += r.grasp_attempts;
   m->grasp_successes += r.grasp_successes;
+  m->holder_releases += r.holder_releases;
+  m->holder_placed += r.holder_placed;
+  for (const auto& b : r.books) m->holder_retreats += b.standing_on_holder >= 0 ? 1 : 0;
+  m->holder_standing += r.holder_standing;
   for (const auto& d : r.decisions) {
     if (!d.p1_present) continue;
     ++m->decisions;
@@ -156,6 +166,9 @@ std::string metrics_json(const EvalMetrics& m, const std::string& command) {
   j << "  \"grasp_attempts\": " << m.grasp_attempts << ",\n";
   j << "  \"grasp_successes\": " << m.grasp_successes << ",\n";
   j << "  \"grasp_success_rate\": " << rate(m.grasp_successes, m.grasp_attempts) << ",\n";
+  j << "  \"holder_releases\": " << m.holder_releases << ",\n";
+  j << "  \"holder_placed_rate\": " << rate(m.holder_placed, m.holder_releases) << ",\n";
+  j << "  \"holder_standing_rate\": " << rate(m.holder_standing, m.holder_retreats) << ",\n";
   j << "  \"p1_p2_decisions\": " << m.decisions << ",\n";
   j << "  \"p1_p2_agreement_rate\": " << rate(m.decisions_agreeing, m.decisions) << ",\n";
   j << "  \"widths_measured\": " << m.widths << ",\n";

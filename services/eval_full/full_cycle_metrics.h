@@ -41,6 +41,10 @@ struct EvalMetrics {
   int books_moved = 0;
   int grasp_attempts = 0;
   int grasp_successes = 0;
+  int holder_releases = 0;                   ///< books the coordinator released on the holder
+  int holder_placed = 0;                     ///< ... that were on it (truth) after the release
+  int holder_retreats = 0;                   ///< ... from which the gripper retreated
+  int holder_standing = 0;                   ///< ... and that then stood on the ledge (truth)
   int decisions = 0;                         ///< GRASP decisions with a P1
   int decisions_agreeing = 0;
   int widths = 0;                            ///< books with a measured width
@@ -55,7 +59,8 @@ struct EvalMetrics {
   std::map<std::string, int> failure_modes;  ///< reason class -> count
 };
 
-/// The failure class of a scene ("" = none): ERROR, ABORTED: <state>, BUDGET in <state>, GRASP_SLIPPED, ...
+/// The failure class of a scene ("" = none): ERROR, BOOK_NOT_ON_HOLDER (a released book that the truth does not
+/// place on the holder: named before the abort it leads to), ABORTED: <state>, BUDGET in <state>, GRASP_RETRIED, ...
 std::string failure_reason(const FullCycleResult& r, int max_books);
 
 /// Accumulates `outcome` into `m` (max_books as given to the harness, 0 = all books).

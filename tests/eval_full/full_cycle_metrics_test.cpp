@@ -23,6 +23,9 @@ SceneOutcome done_scene(uint64_t seed) {
   r.books_moved = 2;
   r.grasp_attempts = 3;  // one retry
   r.grasp_successes = 2;
+  r.holder_releases = 2;
+  r.holder_placed = 2;
+  r.holder_standing = 2;
   r.final_truth.books = {truth_book("lower_shelf"), truth_book("lower_shelf")};
   r.final_truth.num_books = 2;
   BookRecord a;
@@ -32,6 +35,8 @@ SceneOutcome done_scene(uint64_t seed) {
   a.grasp_attempts = 1;
   a.grasp_successes = 1;  // the plates closed on the book (physics)
   a.moved = true;
+  a.place_after_holder_release = "holder";
+  a.standing_on_holder = 1;
   a.start_s = 0;
   a.end_s = 100;
   BookRecord b = a;
@@ -79,6 +84,9 @@ TEST(FullCycleMetrics, AccumulatesRatesAndErrors) {
   EXPECT_EQ(m.books_moved, 2);
   EXPECT_EQ(m.grasp_attempts, 3);
   EXPECT_EQ(m.grasp_successes, 2);
+  EXPECT_EQ(m.holder_releases, 2);
+  EXPECT_EQ(m.holder_placed, 2);
+  EXPECT_EQ(m.holder_standing, 2);
   EXPECT_EQ(m.decisions, 2);  // the decision without P1 is not an agreement sample
   EXPECT_EQ(m.decisions_agreeing, 1);
   EXPECT_EQ(m.widths, 2);
@@ -116,6 +124,26 @@ TEST(FullCycleMetrics, FailureReasons) {
   EXPECT_EQ(failure_reason(r, 0), "DONE with 1 book(s) neither on a shelf");
   r.final_truth.books = {truth_book("lower_shelf"), truth_book("lower_shelf")};
   EXPECT_EQ(failure_reason(r, 0), "");
+  // A book the coordinator released on the holder that the truth does not place there names the scene's
+  // failure, before the abort it leads to (the grasp from the holder closing on nothing).
+  r.end = "ABORTED";
+  r.message = "aborted in MOVE_TO_HOLDER_PRE_GRASP: book 0: last: plan failed";
+  BookRecord lost;
+  lost.grasp_attempts = lost.grasp_successes = 1;
+  lost.place_after_holder_release = "other";
+  r.books = {lost};
+  EXPECT_EQ(failure_reason(r, 1), "BOOK_NOT_ON_HOLDER after RELEASE_ON_HOLDER: the book is other");
+  r.books[0].grasp_successes = 0;  // the plates closed on something, the book stayed on the shelf
+  r.books[0].place_after_holder_release = "upper_shelf";
+  EXPECT_EQ(failure_reason(r, 1),
+            "BOOK_NOT_ON_HOLDER after RELEASE_ON_HOLDER: the book is upper_shelf (it was not in the plates after "
+            "EXTRACT)");
+  r.books[0].grasp_successes = 1;
+  r.books[0].place_after_holder_release = "holder";
+  r.books[0].standing_on_holder = 0;  // on the holder, but lying on its base after the gripper left
+  EXPECT_EQ(failure_reason(r, 1), "BOOK_NOT_STANDING_ON_HOLDER after RETREAT_FROM_HOLDER");
+  r.books[0].standing_on_holder = 1;
+  EXPECT_EQ(failure_reason(r, 1), "ABORTED in MOVE_TO_HOLDER_PRE_GRASP: plan failed");
 }
 
 TEST(FullCycleMetrics, JsonCarriesTheRequiredKeys) {
@@ -126,6 +154,7 @@ TEST(FullCycleMetrics, JsonCarriesTheRequiredKeys) {
        {"\"scenes\": 1", "\"grasp_attempts\": 3", "\"grasp_success_rate\": 0.666667", "\"books_moved_rate\": 1",
         "\"p1_p2_agreement_rate\": 0.5", "\"width_within_1cm_rate\": 0.5", "\"width_error_mm\": {\"n\": 2, \"mean\": 9",
         "\"max\": 15", "\"cycle_s\": {\"n\": 2, \"mean\": 110, \"median\": 110", "\"failures\": [",
-        "{\"seed\": 3, \"reason\": \"GRASP_RETRIED"})
+        "{\"seed\": 3, \"reason\": \"GRASP_RETRIED", "\"holder_releases\": 2", "\"holder_placed_rate\": 1",
+        "\"holder_standing_rate\": 1"})
     EXPECT_NE(j.find(key), std::string::npos) << key << " missing in\n" << j;
 }
