@@ -62,7 +62,17 @@ void ArmDriverCore::restart(int64_t now_utime, const Eigen::VectorXd& q, double 
 
 std::string ArmDriverCore::command_trajectory(const JointTrajectory& traj, int64_t id) {
   if (!initialised()) return "no measurement of the arm yet (waiting for SIM_STATE)";
-  const std::string why = validate_trajectory(traj, q_cmd_, limits_, [this](const Eigen::VectorXd& q) {
+  // The current state is where the arm is measured or where it is commanded to be: they differ while
+  // the arm catches up with its setpoint (after a Cartesian motion or a stop, by up to a few
+  // hundredths of a radian); a planner starts from the measured state (ARM_STATE). Validate against
+  // whichever of the two the trajectory starts nearer.
+  const Eigen::VectorXd& current = q_measured_.size() == q_cmd_.size() && !traj.positions.empty() &&
+                                           traj.positions.front().size() == q_cmd_.size() &&
+                                           (traj.positions.front() - q_measured_).cwiseAbs().maxCoeff() <
+                                               (traj.positions.front() - q_cmd_).cwiseAbs().maxCoeff()
+                                       ? q_measured_
+                                       : q_cmd_;
+  const std::string why = validate_trajectory(traj, current, limits_, [this](const Eigen::VectorXd& q) {
     return Eigen::Vector3d(kin_.tip_pose(q).translation());
   });
   if (!why.empty()) return why;

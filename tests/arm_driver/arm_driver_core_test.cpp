@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 namespace bookgrasp {
 namespace {
 
@@ -125,6 +127,38 @@ TEST(ArmDriverCore, StopsWhenHeartbeatsStop) {
   EXPECT_EQ(sp.qd.norm(), 0.0);
   const DriverSetpoint later = d.update(kT0 + 3000000);
   EXPECT_EQ(later.q, sp.q);
+}
+
+// After a Cartesian motion is stopped the arm is still catching up with the setpoint: a trajectory
+// planned from the measured state (ARM_STATE) starts at the current state and is accepted; one that
+// starts near neither the measured state nor the setpoint is refused.
+TEST(ArmDriverCore, ATrajectoryFromTheMeasuredStateIsAcceptedWhileTheArmCatchesUp) {
+  ArmDriverCore d = make_core();
+  d.on_measurement(kT0, home(), 0.06);
+  Eigen::Matrix<double, 6, 1> tw;
+  tw << 0.1, 0.0, 0.0, 0, 0, 0;
+  ASSERT_EQ(d.command_cartesian_velocity(tw, "base", 3), "");
+  DriverSetpoint sp;
+  d.update(kT0);
+  for (int64_t t = kT0 + 10000; t <= kT0 + 1000000; t += 10000) {
+    d.heartbeat();
+    sp = d.update(t);
+  }
+  d.command_stop("servo finished");
+  // The arm lags the setpoint by 0.04 rad on every joint that moved.
+  Eigen::VectorXd lagging = sp.q;
+  for (int j = 0; j < 7; ++j)
+    if (std::abs(sp.q[j] - home()[j]) > 0.05) lagging[j] -= std::copysign(0.04, sp.q[j] - home()[j]);
+  ASSERT_GT((lagging - sp.q).cwiseAbs().maxCoeff(), 0.035);
+  d.on_measurement(kT0 + 1010000, lagging, 0.06);
+  Eigen::VectorXd goal = lagging;
+  goal[0] += 0.2;
+  EXPECT_EQ(d.command_trajectory(move(lagging, goal, 2.0), 8), "");
+  // Neither at the setpoint nor at the measured state: refused with the reason.
+  Eigen::VectorXd off = lagging;
+  off[6] += 0.05;
+  const std::string why = d.command_trajectory(move(off, goal, 2.0), 9);
+  EXPECT_NE(why.find("does not start at the current state"), std::string::npos) << why;
 }
 
 TEST(ArmDriverCore, StopsAtOnceOnStop) {
