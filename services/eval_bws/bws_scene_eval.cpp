@@ -10,6 +10,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "bookgrasp/marker_detections_t.hpp"
+#include "common/image_caption.h"
 #include "common/image_conversion.h"
 #include "common/pose_conversion.h"
 #include "common/sim_render/sim_camera_rig.h"
@@ -37,8 +38,8 @@ RenderedScene render_scene(sim_render::SimCameraRig& rig, int64_t utime) {
   return s;
 }
 
-SceneResult evaluate_scene(const RenderedScene& scene, uint64_t seed, MarkerDetectorNode& markers,
-                           BwsDetectorNode& bws, cv::Mat* overlay) {
+SceneResult evaluate_scene(const RenderedScene& scene, uint64_t seed, MarkerDetectorNode& markers, BwsDetectorNode& bws,
+                           cv::Mat* overlay) {
   SceneResult r;
   r.seed = seed;
   const ground_truth_t& t = scene.truth;
@@ -61,11 +62,23 @@ SceneResult evaluate_scene(const RenderedScene& scene, uint64_t seed, MarkerDete
   bool has_cart = false;
   std::string ids;
   for (const marker_t& m : md.markers) {
-    has_cart = has_cart || m.role == "cart";
     ids += " " + std::to_string(m.id) + (m.role.empty() ? "" : "(" + m.role + ")");
+    if (m.role != "cart" || has_cart) continue;
+    has_cart = true;
+    // The scene's marker frame has y up and z towards the robot; AprilTag's has y down, z into the tag.
+    Eigen::Isometry3d truth = pose_to_isometry(t.cart_marker);
+    truth.linear() = truth.linear() * Eigen::Vector3d(1, -1, -1).asDiagonal();
+    const Eigen::Isometry3d found = pose_to_isometry(m.pose_in_base);
+    r.cart_marker_found = true;
+    r.cart_marker_angle_deg = Eigen::AngleAxisd(found.linear().transpose() * truth.linear()).angle() * 180.0 / M_PI;
+    r.cart_marker_position_mm = (found.translation() - truth.translation()).norm() * 1000.0;
   }
   if (!has_cart) {
     r.failure = "marker detector found no cart marker (" + std::to_string(md.num_markers) + " markers:" + ids + ")";
+    if (overlay) {
+      *overlay = image_to_mat(scene.frame.left).clone();
+      draw_caption(overlay, 0, "seed " + std::to_string(seed) + ": " + r.failure, cv::Scalar(255, 80, 80));
+    }
     return r;
   }
   why = bws.take_markers(md);
@@ -98,10 +111,12 @@ SceneResult evaluate_scene(const RenderedScene& scene, uint64_t seed, MarkerDete
   constexpr int kCornerWindow = 6;
   std::map<int, int> votes;
   const cv::Point pi = o.selection.pi;
-  for (int y = std::max(0, pi.y - kCornerWindow); y <= std::min(o.segmentation.labels.rows - 1, pi.y + kCornerWindow); ++y) {
+  for (int y = std::max(0, pi.y - kCornerWindow); y <= std::min(o.segmentation.labels.rows - 1, pi.y + kCornerWindow);
+       ++y) {
     const int* l = o.segmentation.labels.ptr<int>(y);
     const int* w = scene.owner.ptr<int>(y);
-    for (int x = std::max(0, pi.x - kCornerWindow); x <= std::min(o.segmentation.labels.cols - 1, pi.x + kCornerWindow); ++x) {
+    for (int x = std::max(0, pi.x - kCornerWindow); x <= std::min(o.segmentation.labels.cols - 1, pi.x + kCornerWindow);
+         ++x) {
       if (l[x] != out.selected_label) continue;
       if (o.selection.split && (x < o.selection.band_x0 || x > o.selection.band_x1)) continue;
       ++votes[w[x]];
@@ -168,16 +183,26 @@ std::string stats_json(const Stats& s, int prec = 3) {
   return "{\"mean\": " + num(s.mean, prec) + ", \"median\": " + num(s.median, prec) + ", \"max\": " + num(s.max, prec) +
          "}";
 }
+/// A cart marker pose further than this from the truth is a flipped (ambiguous) solution.
+constexpr double kFlippedMarkerDeg = 10.0;
 struct Summary {
   int scenes = 0, found = 0, wrong = 0, failures = 0, correct = 0;
+  int markers_found = 0, markers_flipped = 0;
+  Stats marker_angle, marker_position;
   Stats err[3], bias[3];
   Stats disp, seg, total;
 };
 Summary summarize(const std::vector<SceneResult>& rs) {
   Summary s;
-  std::vector<double> e[3], b[3], d, g, t;
+  std::vector<double> e[3], b[3], d, g, t, ma, mp;
   for (const SceneResult& r : rs) {
     ++s.scenes;
+    if (r.cart_marker_found) {
+      ++s.markers_found;
+      s.markers_flipped += r.cart_marker_angle_deg > kFlippedMarkerDeg;
+      ma.push_back(r.cart_marker_angle_deg);
+      mp.push_back(r.cart_marker_position_mm);
+    }
     s.found += r.found;
     s.wrong += r.wrong_book;
     if (!r.found || r.wrong_book) ++s.failures;
@@ -198,6 +223,8 @@ Summary summarize(const std::vector<SceneResult>& rs) {
     s.err[i] = stats_of(e[i]);
     s.bias[i] = stats_of(b[i]);
   }
+  s.marker_angle = stats_of(ma);
+  s.marker_position = stats_of(mp);
   s.disp = stats_of(d);
   s.seg = stats_of(g);
   s.total = stats_of(t);
@@ -211,21 +238,27 @@ std::string metrics_json(const std::vector<SceneResult>& rs, const std::string& 
   std::ostringstream j;
   j << "{\n  \"implementation\": \"" << impl << "\",\n  \"scene_file\": \"" << scene_file << "\",\n"
     << "  \"first_seed\": " << first_seed << ",\n  \"scenes\": " << s.scenes << ",\n  \"found\": " << s.found
-    << ",\n  \"failures\": " << s.failures << ",\n  \"no_p1\": " << (s.scenes - s.found) << ",\n  \"wrong_book\": "
-    << s.wrong << ",\n  \"correct\": " << s.correct << ",\n"
-    << "  \"p1_error_mm\": {\"frame\": \"grasp (X up, Y right, Z into the shelf), |estimate - truth| over correct scenes\",\n"
-    << "    \"x\": " << stats_json(s.err[0]) << ",\n    \"y\": " << stats_json(s.err[1]) << ",\n    \"z\": "
-    << stats_json(s.err[2]) << "},\n"
+    << ",\n  \"failures\": " << s.failures << ",\n  \"no_p1\": " << (s.scenes - s.found)
+    << ",\n  \"wrong_book\": " << s.wrong << ",\n  \"correct\": " << s.correct << ",\n"
+    << "  \"p1_error_mm\": {\"frame\": \"grasp (X up, Y right, Z into the shelf), |estimate - truth| over correct "
+       "scenes\",\n"
+    << "    \"x\": " << stats_json(s.err[0]) << ",\n    \"y\": " << stats_json(s.err[1])
+    << ",\n    \"z\": " << stats_json(s.err[2]) << "},\n"
     << "  \"p1_bias_mm\": {\"x\": " << stats_json(s.bias[0]) << ", \"y\": " << stats_json(s.bias[1])
     << ", \"z\": " << stats_json(s.bias[2]) << "},\n"
     << "  \"ms_per_frame\": {\"disparity\": " << stats_json(s.disp, 2) << ", \"segmentation\": " << stats_json(s.seg, 2)
-    << ", \"total\": " << stats_json(s.total, 2) << "},\n  \"per_scene\": [\n";
+    << ", \"total\": " << stats_json(s.total, 2) << "},\n"
+    << "  \"cart_marker\": {\"found\": " << s.markers_found << ", \"flipped\": " << s.markers_flipped
+    << ", \"flipped_above_deg\": " << num(kFlippedMarkerDeg, 1) << ", \"angle_deg\": " << stats_json(s.marker_angle, 2)
+    << ", \"position_mm\": " << stats_json(s.marker_position, 1) << "},\n  \"per_scene\": [\n";
   for (size_t i = 0; i < rs.size(); ++i) {
     const SceneResult& r = rs[i];
     j << "    {\"seed\": " << r.seed << ", \"found\": " << (r.found ? "true" : "false")
-      << ", \"wrong_book\": " << (r.wrong_book ? "true" : "false") << ", \"error_mm\": [" << num(r.error_grasp(0) * 1000, 2)
-      << ", " << num(r.error_grasp(1) * 1000, 2) << ", " << num(r.error_grasp(2) * 1000, 2)
-      << "], \"rightmost_width_mm\": " << num(r.rightmost_width_m * 1000, 1) << ", \"total_ms\": " << num(r.total_ms, 2)
+      << ", \"wrong_book\": " << (r.wrong_book ? "true" : "false") << ", \"error_mm\": ["
+      << num(r.error_grasp(0) * 1000, 2) << ", " << num(r.error_grasp(1) * 1000, 2) << ", "
+      << num(r.error_grasp(2) * 1000, 2)
+      << "], \"cart_marker_angle_deg\": " << (r.cart_marker_found ? num(r.cart_marker_angle_deg, 2) : "null")
+      << ", \"rightmost_width_mm\": " << num(r.rightmost_width_m * 1000, 1) << ", \"total_ms\": " << num(r.total_ms, 2)
       << ", \"failure\": \"";
     for (char c : r.failure) j << (c == '"' || c == '\\' ? '\'' : c);
     j << "\"}" << (i + 1 < rs.size() ? "," : "") << "\n";
@@ -241,20 +274,27 @@ std::string report_markdown(const std::vector<SceneResult>& rs, const std::strin
     << "Scenes: " << s.scenes << "; P1 found: " << s.found << "; wrong book: " << s.wrong
     << "; failures (no P1 or wrong book): " << s.failures << " (paper: 2 of 20).\n\n"
     << "P1 error |estimate - truth| in the true grasp frame (X up, Y right, Z into the shelf), mm, over the "
-    << s.correct << " correct scenes:\n\n| axis | mean | median | max | signed mean (bias) | paper mean |\n|---|---|---|---|---|---|\n";
+    << s.correct
+    << " correct scenes:\n\n| axis | mean | median | max | signed mean (bias) | paper mean "
+       "|\n|---|---|---|---|---|---|\n";
   const char* ax = "XYZ";
   const double paper[3] = {5.2, 11.7, 3.8};
   for (int i = 0; i < 3; ++i)
     m << "| " << ax[i] << " | " << num(s.err[i].mean, 2) << " | " << num(s.err[i].median, 2) << " | "
       << num(s.err[i].max, 2) << " | " << num(s.bias[i].mean, 2) << " | " << num(paper[i], 1) << " |\n";
+  m << "\nCart marker (marker_detector against the true tag pose): found in " << s.markers_found << " of " << s.scenes
+    << " scenes; rotation error median " << num(s.marker_angle.median, 2) << " deg, max " << num(s.marker_angle.max, 2)
+    << " deg; " << s.markers_flipped << " flipped (> " << num(kFlippedMarkerDeg, 0)
+    << " deg, the planar pose ambiguity); centre error median " << num(s.marker_position.median, 1) << " mm, max "
+    << num(s.marker_position.max, 1) << " mm.\n";
   m << "\nWall time per frame, ms (machine shared, wall clock): disparity median " << num(s.disp.median, 1)
     << ", segmentation median " << num(s.seg.median, 1) << ", total median " << num(s.total.median, 1) << " (max "
     << num(s.total.max, 1) << ").\n\n![P1 error per scene](figure12.png)\n\n## Failed scenes\n\n";
   int listed = 0;
   for (const SceneResult& r : rs)
     if (!r.found || r.wrong_book) {
-      m << "- seed " << r.seed << " (right-most book " << num(r.rightmost_width_m * 1000, 1) << " mm thick): "
-        << r.failure << "\n";
+      m << "- seed " << r.seed << " (right-most book " << num(r.rightmost_width_m * 1000, 1)
+        << " mm thick): " << r.failure << "\n";
       ++listed;
     }
   if (!listed) m << "None.\n";
@@ -273,7 +313,8 @@ cv::Mat figure12_plot(const std::vector<SceneResult>& rs, const std::string& tit
   const auto ypix = [&](double v) { return T + ph - int(std::round(std::min(v, ymax) / ymax * ph)); };
   for (double v = 0; v <= ymax + 1e-9; v += ymax / 5) {
     cv::line(img, {L, ypix(v)}, {W - R, ypix(v)}, cv::Scalar(225, 225, 225));
-    cv::putText(img, num(v, 0), {L - 40, ypix(v) + 5}, cv::FONT_HERSHEY_SIMPLEX, 0.45, cv::Scalar(0, 0, 0), 1, cv::LINE_AA);
+    cv::putText(img, num(v, 0), {L - 40, ypix(v) + 5}, cv::FONT_HERSHEY_SIMPLEX, 0.45, cv::Scalar(0, 0, 0), 1,
+                cv::LINE_AA);
   }
   const cv::Scalar col[3] = {cv::Scalar(31, 119, 180), cv::Scalar(255, 127, 14), cv::Scalar(44, 160, 44)};
   const int n = std::max<int>(1, int(rs.size()));

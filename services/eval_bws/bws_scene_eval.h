@@ -45,6 +45,12 @@ struct SceneResult {
   int rightmost_id = -1;
   /// Right-most book's thickness, metres (truth), for the report.
   double rightmost_width_m = 0.0;
+  /// The marker detector found the cart marker.
+  bool cart_marker_found = false;
+  /// Rotation between the detected cart marker pose (in base) and the true one, degrees (valid when found).
+  double cart_marker_angle_deg = 0.0;
+  /// Distance between the detected and the true cart marker centre, millimetres (valid when found).
+  double cart_marker_position_mm = 0.0;
   /// Stage times from the message, milliseconds.
   double disparity_ms = 0.0;
   /// See disparity_ms.
@@ -69,8 +75,8 @@ RenderedScene render_scene(sim_render::SimCameraRig& rig, int64_t utime);
 /// Evaluates one rendered scene with the given components (their state:
 /// the marker detector's markers are handed to `bws` before the frame).
 /// If `overlay` is not null it receives the detector's debug picture (RGB).
-SceneResult evaluate_scene(const RenderedScene& scene, uint64_t seed, MarkerDetectorNode& markers,
-                           BwsDetectorNode& bws, cv::Mat* overlay);
+SceneResult evaluate_scene(const RenderedScene& scene, uint64_t seed, MarkerDetectorNode& markers, BwsDetectorNode& bws,
+                           cv::Mat* overlay);
 
 /// Summary statistics of a sample.
 struct Stats {

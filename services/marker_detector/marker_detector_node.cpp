@@ -2,6 +2,9 @@
 
 #include <chrono>
 #include <cmath>
+#include <cstdio>
+#include <optional>
+#include <set>
 #include <stdexcept>
 
 #include <opencv2/imgproc.hpp>
@@ -16,11 +19,15 @@ MarkerDetectorSettings MarkerDetectorSettings::from_config(const Config& root) {
   s.input_channel = root.get<std::string>("channels.input");
   s.output_channel = root.get<std::string>("channels.output");
   s.detector = TagDetectorParams::from_config(root.child("apriltag"));
+  s.fallback_quad_sigma = root.get_double("apriltag.fallback_quad_sigma", 0.0, 5.0);
   s.default_tag_size_m = root.get_double("tags.default_size_m", 0.005, 2.0);
   s.cart_ids = root.get<std::vector<int>>("tags.cart.ids");
   s.cart_tag_size_m = root.get_double("tags.cart.size_m", 0.005, 2.0);
   s.holder_ids = root.get<std::vector<int>>("tags.holder.ids");
   s.holder_tag_size_m = root.get_double("tags.holder.size_m", 0.005, 2.0);
+  s.cart_max_tilt_rad = root.get_double("tags.cart.max_tilt_deg", 0.0, 180.0) * M_PI / 180.0;
+  s.holder_max_tilt_rad = root.get_double("tags.holder.max_tilt_deg", 0.0, 180.0) * M_PI / 180.0;
+  s.pose_ambiguity_px = root.get_double("tags.pose_ambiguity_px", 0.0, 100.0);
   s.report_unassigned = root.get<bool>("tags.report_unassigned");
   s.measure_processing_time = root.get<bool>("diagnostics.measure_processing_time");
   for (int id : s.cart_ids) {
@@ -45,7 +52,8 @@ bool intrinsics_from_calibration(const camera_calibration_t& c, int image_width,
     return false;
   }
   if (c.fx <= 0.0 || c.fy <= 0.0) {
-    *reason = "calibration focal lengths must be > 0 (fx=" + std::to_string(c.fx) + ", fy=" + std::to_string(c.fy) + ")";
+    *reason =
+        "calibration focal lengths must be > 0 (fx=" + std::to_string(c.fx) + ", fy=" + std::to_string(c.fy) + ")";
     return false;
   }
   if (c.width != image_width || c.height != image_height) {
@@ -91,6 +99,11 @@ bool intrinsics_from_calibration(const camera_calibration_t& c, int image_width,
 
 MarkerDetectorNode::MarkerDetectorNode(const MarkerDetectorSettings& settings)
     : Component("marker_detector", "apriltag3"), settings_(settings), detector_(settings.detector) {
+  if (settings_.fallback_quad_sigma > 0) {
+    TagDetectorParams p = settings_.detector;
+    p.quad_sigma = settings_.fallback_quad_sigma;
+    fallback_detector_.emplace(p);
+  }
   for (int id : settings_.cart_ids) role_of_id_[id] = "cart";
   for (int id : settings_.holder_ids) role_of_id_[id] = "holder";
   subscribe(settings_.input_channel, &MarkerDetectorNode::on_stereo);
@@ -128,7 +141,17 @@ bool MarkerDetectorNode::process(const stereo_frame_t& frame, marker_detections_
   const std::string camera_frame =
       frame.left_calibration.frame.empty() ? frame.left.frame : frame.left_calibration.frame;
 
-  const std::vector<TagDetection> detections = detector_.detect(gray);
+  std::vector<TagDetection> detections = detector_.detect(gray);
+  if (fallback_detector_) {
+    // A cart or holder tag the first pass missed: search again with a blur (aliased or noisy edges,
+    // e.g. the rendered tags), and take the role tags it finds that the first pass did not.
+    std::set<int> missing;
+    for (const auto& [id, role] : role_of_id_) missing.insert(id);
+    for (const TagDetection& d : detections) missing.erase(d.id);
+    if (!missing.empty())
+      for (const TagDetection& d : fallback_detector_->detect(gray))
+        if (missing.count(d.id)) detections.push_back(d);
+  }
   out->utime = frame.left.utime;
   out->implementation = implementation();
   out->camera_frame = camera_frame;
@@ -142,7 +165,27 @@ bool MarkerDetectorNode::process(const stereo_frame_t& frame, marker_detections_
                                            : settings_.default_tag_size_m;
     TagPose pose;
     try {
-      pose = estimate_tag_pose(d.corners, size, k);
+      const std::vector<TagPose> candidates = estimate_tag_pose_candidates(d.corners, size, k);
+      if (role.empty()) {
+        pose = candidates.front();
+      } else {
+        // The cart's and the holder's tags are mounted upright: of IPPE's two solutions (a small or
+        // distant tag fits a mirrored tilt nearly as well) take the one that is.
+        const double max_tilt = role == "cart" ? settings_.cart_max_tilt_rad : settings_.holder_max_tilt_rad;
+        const std::optional<TagPose> upright =
+            choose_upright_pose(candidates, camera_in_base, max_tilt, settings_.pose_ambiguity_px);
+        if (!upright) {
+          char buf[200];
+          std::snprintf(buf, sizeof buf,
+                        "%s tag %d dropped: no pose within %.0f deg of upright (best fit tilted %.0f deg, %.2f px)",
+                        role.c_str(), d.id, max_tilt * 180.0 / M_PI,
+                        tag_tilt_from_upright(candidates.front().tag_in_camera, camera_in_base) * 180.0 / M_PI,
+                        candidates.front().reprojection_error_px);
+          report_error(buf);
+          continue;
+        }
+        pose = *upright;
+      }
     } catch (const std::exception& e) {
       report_error("tag " + std::to_string(d.id) + ": " + e.what());
       continue;
@@ -167,10 +210,9 @@ bool MarkerDetectorNode::process(const stereo_frame_t& frame, marker_detections_
     out->markers.push_back(m);
   }
   out->num_markers = static_cast<int32_t>(out->markers.size());
-  out->processing_ms =
-      settings_.measure_processing_time
-          ? std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count()
-          : 0.0;
+  out->processing_ms = settings_.measure_processing_time
+                           ? std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count()
+                           : 0.0;
   return true;
 }
 

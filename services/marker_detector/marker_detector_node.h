@@ -5,6 +5,7 @@
 /// `base`, and the role of the cart and holder markers).
 
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -19,15 +20,21 @@ namespace bookgrasp {
 
 /// Everything the marker detector reads from its configuration.
 struct MarkerDetectorSettings {
-  std::string input_channel;      ///< channels.input (stereo_frame_t)
-  std::string output_channel;     ///< channels.output (marker_detections_t)
-  TagDetectorParams detector;     ///< apriltag.*
-  double default_tag_size_m = 0;  ///< tags.default_size_m: size of tags without a role
-  std::vector<int> cart_ids;      ///< tags.cart.ids
-  double cart_tag_size_m = 0;     ///< tags.cart.size_m
-  std::vector<int> holder_ids;    ///< tags.holder.ids
-  double holder_tag_size_m = 0;   ///< tags.holder.size_m
-  bool report_unassigned = true;  ///< tags.report_unassigned: publish tags whose id has no role
+  std::string input_channel;            ///< channels.input (stereo_frame_t)
+  std::string output_channel;           ///< channels.output (marker_detections_t)
+  TagDetectorParams detector;           ///< apriltag.*
+  double fallback_quad_sigma = 0;       ///< apriltag.fallback_quad_sigma: a second pass with this blur when a cart or
+                                        ///< holder id was not found (<= 0: no second pass)
+  double default_tag_size_m = 0;        ///< tags.default_size_m: size of tags without a role
+  std::vector<int> cart_ids;            ///< tags.cart.ids
+  double cart_tag_size_m = 0;           ///< tags.cart.size_m
+  std::vector<int> holder_ids;          ///< tags.holder.ids
+  double holder_tag_size_m = 0;         ///< tags.holder.size_m
+  double cart_max_tilt_rad = 0;         ///< tags.cart.max_tilt_deg: the cart tag is upright within this
+  double holder_max_tilt_rad = 0;       ///< tags.holder.max_tilt_deg: the holder tag is upright within this
+  double pose_ambiguity_px = 0;         ///< tags.pose_ambiguity_px: IPPE solutions this close in error are both
+                                        ///< considered for an upright (cart, holder) tag
+  bool report_unassigned = true;        ///< tags.report_unassigned: publish tags whose id has no role
   bool measure_processing_time = true;  ///< diagnostics.measure_processing_time (wall time in processing_ms)
 
   /// Reads the whole configuration root (channels, apriltag, tags,
@@ -58,6 +65,7 @@ class MarkerDetectorNode : public Component {
 
   MarkerDetectorSettings settings_;
   TagDetector detector_;
+  std::optional<TagDetector> fallback_detector_;  ///< the blurred second pass (fallback_quad_sigma > 0)
   std::map<int, std::string> role_of_id_;
 };
 

@@ -13,11 +13,10 @@ namespace bookgrasp {
 /// The marker_detector service.
 inline ServiceDescription marker_detector_service() {
   return ServiceDescription{
-          "marker_detector", "AprilTag 3 markers (cart, holder) of the left stereo image -> MARKERS",
-          "config/services/marker_detector.yaml", [](const bookgrasp::Config& root) {
-            return std::make_unique<bookgrasp::MarkerDetectorNode>(
-                bookgrasp::MarkerDetectorSettings::from_config(root));
-          }};
+      "marker_detector", "AprilTag 3 markers (cart, holder) of the left stereo image -> MARKERS",
+      "config/services/marker_detector.yaml", [](const bookgrasp::Config& root) {
+        return std::make_unique<bookgrasp::MarkerDetectorNode>(bookgrasp::MarkerDetectorSettings::from_config(root));
+      }};
 }
 
 }  // namespace bookgrasp

@@ -16,7 +16,7 @@ namespace bookgrasp {
 
 /// Settings of the AprilTag detector (see apriltag.h for their meaning).
 struct TagDetectorParams {
-  std::string family = "tag36h11";  ///< tag family: tag36h11, tag25h9 or tag16h5
+  std::string family = "tag36h11";   ///< tag family: tag36h11, tag25h9 or tag16h5
   double quad_decimate = 2.0;        ///< quad detection on an image decimated by this factor (1 = full size)
   double quad_sigma = 0.0;           ///< Gaussian blur sigma applied before quad detection (0 = none)
   bool refine_edges = true;          ///< snap quad edges to strong image gradients
@@ -33,15 +33,15 @@ struct TagDetectorParams {
 
 /// One tag found in an image, in the detector's conventions.
 struct TagDetection {
-  std::string family;                    ///< family name, e.g. "tag36h11"
-  int id = -1;                           ///< decoded id
-  int hamming = 0;                       ///< bits corrected
-  double decision_margin = 0.0;          ///< mean distance of data bits from the threshold (higher = better)
+  std::string family;            ///< family name, e.g. "tag36h11"
+  int id = -1;                   ///< decoded id
+  int hamming = 0;               ///< bits corrected
+  double decision_margin = 0.0;  ///< mean distance of data bits from the threshold (higher = better)
   /// Image corners (x, y) in pixels, AprilTag order: counter-clockwise as seen
   /// in the image, starting at the corner of tag coordinates (-1, +1), i.e.
   /// for an upright tag: bottom-left, bottom-right, top-right, top-left.
   std::array<cv::Point2d, 4> corners;
-  cv::Point2d center;                    ///< image of the tag centre, pixels
+  cv::Point2d center;  ///< image of the tag centre, pixels
 };
 
 /// The AprilTag detector. Not copyable (it owns the C detector and family);

@@ -1,9 +1,12 @@
 #pragma once
 /// @file
 /// Pose of a square tag from its four image corners and the camera
-/// intrinsics (IPPE for squares, refined by Levenberg-Marquardt).
+/// intrinsics (IPPE for squares, refined by Levenberg-Marquardt), and the
+/// choice between IPPE's two solutions (the planar pose ambiguity: a small or
+/// distant tag fits a mirrored tilt almost as well) by the tag's known mounting.
 
 #include <array>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -41,6 +44,24 @@ struct TagPose {
 /// intrinsics, and std::runtime_error if no pose is found (degenerate quad).
 TagPose estimate_tag_pose(const std::array<cv::Point2d, 4>& corners, double tag_size_m,
                           const TagCameraIntrinsics& intrinsics);
+
+/// Both poses IPPE finds for the corners (the planar ambiguity), each refined by
+/// Levenberg-Marquardt, sorted by reprojection error (best first); one or two.
+/// Throws as estimate_tag_pose.
+std::vector<TagPose> estimate_tag_pose_candidates(const std::array<cv::Point2d, 4>& corners, double tag_size_m,
+                                                  const TagCameraIntrinsics& intrinsics);
+
+/// Angle between a tag's "down" axis (its y axis: towards the tag's bottom edge) and straight down
+/// (-z of `base`), radians, for the tag at `tag_in_camera` seen by a camera at `camera_in_base`.
+double tag_tilt_from_upright(const Eigen::Isometry3d& tag_in_camera, const Eigen::Isometry3d& camera_in_base);
+
+/// The pose of a tag mounted upright (its bottom edge down, on a vertical or leaning board): among
+/// `candidates` (sorted by reprojection error) whose error is within `ambiguity_px` of the best, the
+/// one tilted least from upright. Nothing when that one is tilted more than `max_tilt_rad` (no
+/// pose fits the mounting: a wrong id, a tag knocked over, or both solutions bad).
+std::optional<TagPose> choose_upright_pose(const std::vector<TagPose>& candidates,
+                                           const Eigen::Isometry3d& camera_in_base, double max_tilt_rad,
+                                           double ambiguity_px);
 
 /// Projects the four tag corners of a tag of `tag_size_m` at `tag_in_camera`
 /// into the image (same order as TagDetection::corners).

@@ -32,6 +32,9 @@ MarkerDetectorSettings settings() {
   s.cart_tag_size_m = 0.10;
   s.holder_ids = {4};
   s.holder_tag_size_m = 0.06;
+  // These synthetic tags face the tilted camera, not upright: no mounting prior here (tests/.../test_tag_pose).
+  s.cart_max_tilt_rad = s.holder_max_tilt_rad = kPi;
+  s.pose_ambiguity_px = 0.0;
   return s;
 }
 
@@ -249,9 +252,9 @@ TEST(MarkerDetectorConfig, SharedIdIsRefusedNamingTheKey) {
   std::string yaml =
       "channels: {input: A, output: B}\n"
       "apriltag: {family: tag36h11, quad_decimate: 2, quad_sigma: 0, refine_edges: true, decode_sharpening: 0.25,"
-      " threads: 1, max_hamming: 1, min_decision_margin: 20}\n"
-      "tags: {default_size_m: 0.08, report_unassigned: true, cart: {ids: [0, 2], size_m: 0.08},"
-      " holder: {ids: [2], size_m: 0.08}}\n"
+      " threads: 1, max_hamming: 1, min_decision_margin: 20, fallback_quad_sigma: 0}\n"
+      "tags: {default_size_m: 0.08, report_unassigned: true, cart: {ids: [0, 2], size_m: 0.08, max_tilt_deg: 20},"
+      " holder: {ids: [2], size_m: 0.08, max_tilt_deg: 35}, pose_ambiguity_px: 1.0}\n"
       "diagnostics: {measure_processing_time: false}\n";
   try {
     MarkerDetectorSettings::from_config(Config::from_string(yaml));

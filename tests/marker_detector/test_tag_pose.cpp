@@ -41,8 +41,8 @@ double angle_deg(const Eigen::Matrix3d& a, const Eigen::Matrix3d& b) {
 }
 
 struct PoseCase {
-  double x, y, z;          // tag centre in the camera, metres
-  double roll, pitch, yaw; // degrees, applied to a tag facing the camera
+  double x, y, z;           // tag centre in the camera, metres
+  double roll, pitch, yaw;  // degrees, applied to a tag facing the camera
 };
 
 class RenderedPose : public ::testing::TestWithParam<PoseCase> {};
@@ -106,6 +106,58 @@ TEST(TagPose, DistortionIsUsed) {
   const auto corners = project_tag_corners(truth, 0.08, k);
   const TagPose pose = estimate_tag_pose(corners, 0.08, k);
   EXPECT_LT((pose.tag_in_camera.translation() - truth.translation()).norm(), 1e-6);
+}
+
+// A camera 1.6 m from an upright tag (a vertical board facing it), looking down at 30 deg: the view
+// of the stereo camera onto the cart's rear board.
+struct DownwardView {
+  Eigen::Isometry3d camera_in_base = Eigen::Isometry3d::Identity();
+  Eigen::Isometry3d tag_in_camera = Eigen::Isometry3d::Identity();
+  DownwardView() {
+    const double p = 30.0 * kPi / 180.0;
+    const Eigen::Vector3d z(std::cos(p), 0, -std::sin(p)), x(0, -1, 0);
+    camera_in_base.linear() << x, z.cross(x), z;
+    Eigen::Isometry3d tag_in_base = Eigen::Isometry3d::Identity();
+    tag_in_base.linear() << Eigen::Vector3d(0, -1, 0), Eigen::Vector3d(0, 0, -1), Eigen::Vector3d(1, 0, 0);
+    tag_in_base.translation() = 1.6 * z;
+    tag_in_camera = camera_in_base.inverse() * tag_in_base;
+  }
+};
+
+TEST(TagPose, CandidatesAreTheTruthAndItsMirrorBestFirst) {
+  const DownwardView v;
+  const auto corners = project_tag_corners(v.tag_in_camera, 0.08, intrinsics());
+  const std::vector<TagPose> c = estimate_tag_pose_candidates(corners, 0.08, intrinsics());
+  ASSERT_EQ(c.size(), 2u);
+  EXPECT_LE(c[0].reprojection_error_px, c[1].reprojection_error_px);
+  EXPECT_LT(angle_deg(c[0].tag_in_camera.linear(), v.tag_in_camera.linear()), 0.01);
+  // The mirror: tilted back by tens of degrees, its corners still within a pixel.
+  EXPECT_GT(angle_deg(c[1].tag_in_camera.linear(), v.tag_in_camera.linear()), 20.0);
+  EXPECT_LT(c[1].reprojection_error_px, 1.0);
+  EXPECT_NEAR(tag_tilt_from_upright(c[0].tag_in_camera, v.camera_in_base), 0.0, 1e-4);
+  EXPECT_GT(tag_tilt_from_upright(c[1].tag_in_camera, v.camera_in_base), 20.0 * kPi / 180.0);
+}
+
+TEST(TagPose, UprightChoiceTakesTheMountedSolutionWhenTheMirrorFitsSlightlyBetter) {
+  const DownwardView v;
+  const auto corners = project_tag_corners(v.tag_in_camera, 0.08, intrinsics());
+  std::vector<TagPose> c = estimate_tag_pose_candidates(corners, 0.08, intrinsics());
+  ASSERT_EQ(c.size(), 2u);
+  // Corner noise made the mirror fit best (as seen on a far cart): errors 0.3 px vs 0.6 px.
+  std::swap(c[0], c[1]);
+  c[0].reprojection_error_px = 0.3;
+  c[1].reprojection_error_px = 0.6;
+  const double max_tilt = 20.0 * kPi / 180.0;
+  const auto upright = choose_upright_pose(c, v.camera_in_base, max_tilt, 1.0);
+  ASSERT_TRUE(upright.has_value());
+  EXPECT_LT(angle_deg(upright->tag_in_camera.linear(), v.tag_in_camera.linear()), 0.01);
+  // Outside the ambiguity window only the mirror is considered: not upright, so no pose.
+  EXPECT_FALSE(choose_upright_pose(c, v.camera_in_base, max_tilt, 0.1).has_value());
+  // Without a tilt limit that mirror is returned.
+  const auto any = choose_upright_pose(c, v.camera_in_base, kPi, 0.1);
+  ASSERT_TRUE(any.has_value());
+  EXPECT_DOUBLE_EQ(any->reprojection_error_px, 0.3);
+  EXPECT_FALSE(choose_upright_pose({}, v.camera_in_base, kPi, 1.0).has_value());
 }
 
 TEST(TagPose, BadInputsThrow) {
