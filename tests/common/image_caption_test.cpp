@@ -19,9 +19,9 @@ TEST(ImageCaption, AShortTextTakesOneLine) {
   EXPECT_EQ(draw_caption(&img, 0, "P1 found", cv::Scalar(255, 255, 255)), 1);
   EXPECT_GT(changed_pixels_in_line(img, 0), 50);
   EXPECT_EQ(changed_pixels_in_line(img, 2), 0);
-  // White text outlined in black: both are there.
+  // White text outlined in black: both are there (the 1 px white stroke is anti-aliased, rarely pure white).
   cv::Mat white, black;
-  cv::inRange(img, cv::Scalar(250, 250, 250), cv::Scalar(255, 255, 255), white);
+  cv::inRange(img, cv::Scalar(200, 200, 200), cv::Scalar(255, 255, 255), white);  // anti-aliased strokes
   cv::inRange(img, cv::Scalar(0, 0, 0), cv::Scalar(5, 5, 5), black);
   EXPECT_GT(cv::countNonZero(white), 10);
   EXPECT_GT(cv::countNonZero(black), 10);
