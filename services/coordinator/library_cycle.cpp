@@ -2,18 +2,18 @@
 
 #include <algorithm>
 #include <cmath>
-#include <limits>
 #include <cstdio>
 #include <initializer_list>
+#include <limits>
 
 namespace bookgrasp {
 namespace {
 
 constexpr int kArmIdle = 0;
 constexpr int kArmExecuting = 1;
-constexpr double kForeignMotionSettleS = 0.3;  ///< still this long after stopping a predecessor's motion
-constexpr double kPlanStartToleranceRad = 0.01; ///< a plan whose start the arm has left by more is made again
-                                                ///< (the driver accepts 0.03 rad)
+constexpr double kForeignMotionSettleS = 0.3;    ///< still this long after stopping a predecessor's motion
+constexpr double kPlanStartToleranceRad = 0.01;  ///< a plan whose start the arm has left by more is made again
+                                                 ///< (the driver accepts 0.03 rad)
 constexpr int kArmStopped = 2;
 constexpr int kArmFault = 3;
 constexpr int kServoBookCorner = 1;
@@ -483,6 +483,15 @@ void LibraryCycle::after_motion() {
       succeed(CycleState::kExtract);
       return;
     case CycleState::kExtract:
+      if (arm_ && !arm_->gripper_contact && arm_->gripper_width < s_.min_book_width) {
+        // The book slipped out while it was pulled out (a grasp too near its top edge): the plates
+        // closed on nothing. Where it lies is unknown; carrying on would take empty plates to the holder.
+        abort("book " + std::to_string(progress_.books_moved) +
+              " is not in the gripper after EXTRACT (no contact, plates at " +
+              std::to_string(arm_->gripper_width * 1000.0) +
+              " mm): it slipped out; find it, correct the progress file, restart");
+        return;
+      }
       succeed(CycleState::kMoveToHolder);
       return;
     case CycleState::kMoveToHolder:

@@ -449,6 +449,20 @@ TEST(LibraryCycle, APlanWhoseStartTheArmLeftWhilePlanningIsMadeAgain) {
   EXPECT_EQ(std::count(executed.begin(), executed.end(), plans[1].id), 1);
 }
 
+TEST(LibraryCycle, ABookThatSlipsOutDuringExtractAbortsInsteadOfCarryingEmptyPlates) {
+  FakeLibrary w(three_books());
+  LibraryCycle c(settings(), std::nullopt);
+  w.run(c, [&] { return c.state() == CycleState::kExtract; });
+  ASSERT_EQ(c.state(), CycleState::kExtract);
+  w.contact = false;  // the book slides out of the plates while it is pulled out
+  w.width = 0.0;
+  w.in_gripper.reset();
+  w.run(c, [&] { return done_or_aborted(c); });
+  ASSERT_EQ(c.state(), CycleState::kAborted);
+  EXPECT_NE(c.status().message.find("not in the gripper after EXTRACT"), std::string::npos) << c.status().message;
+  EXPECT_EQ(count(w.states, "MOVE_TO_HOLDER"), 0);
+}
+
 TEST(LibraryCycle, ResumeWithABookExpectedInTheGripperButNoContactAborts) {
   FakeLibrary w(three_books());
   LibraryCycle first(settings(), std::nullopt);
