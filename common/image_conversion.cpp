@@ -175,6 +175,15 @@ image_t encode_image(const cv::Mat& mat, const std::string& encoding, int64_t ut
   throw ImageError("unknown image encoding '" + encoding + "' (raw, png or jpeg)");
 }
 
+cv::Mat to_rgb_copy(const cv::Mat& image) {
+  cv::Mat rgb;
+  if (image.channels() == 1)
+    cv::cvtColor(image, rgb, cv::COLOR_GRAY2RGB);
+  else
+    rgb = image.clone();
+  return rgb;
+}
+
 void write_png(const std::string& path, const cv::Mat& mat) {
   cv::Mat out;
   if (mat.type() == CV_8UC3) cv::cvtColor(mat, out, cv::COLOR_RGB2BGR);

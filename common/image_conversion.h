@@ -58,6 +58,9 @@ inline const std::vector<std::string>& image_encodings() {
 /// Throws ImageError for another encoding.
 image_t encode_image(const cv::Mat& mat, const std::string& encoding, int64_t utime, const std::string& frame);
 
+/// A CV_8UC3 RGB copy of a grey (CV_8UC1) or RGB (CV_8UC3) image, to draw on.
+cv::Mat to_rgb_copy(const cv::Mat& image);
+
 /// Writes a CV_8UC1, CV_8UC3 (RGB) or CV_16UC1 Mat to a PNG file. Throws ImageError on failure.
 void write_png(const std::string& path, const cv::Mat& mat);
 

@@ -6,15 +6,12 @@
 #include <opencv2/imgproc.hpp>
 
 #include "common/image_caption.h"
+#include "common/image_conversion.h"
 
 namespace bookgrasp {
 
 cv::Mat draw_bswh_overlay(const cv::Mat& image, const StripeDetection& d, const std::string& title) {
-  cv::Mat img;
-  if (image.channels() == 1)
-    cv::cvtColor(image, img, cv::COLOR_GRAY2RGB);
-  else
-    img = image.clone();
+  cv::Mat img = to_rgb_copy(image);
   char buf[256];
   if (d.found) {
     // The band's two borders half a thickness either side of the centre line, then the line itself.

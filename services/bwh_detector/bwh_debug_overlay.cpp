@@ -6,15 +6,12 @@
 #include <opencv2/imgproc.hpp>
 
 #include "common/image_caption.h"
+#include "common/image_conversion.h"
 
 namespace bookgrasp {
 
 cv::Mat draw_bwh_overlay(const cv::Mat& image, const BookDetection& d, int rank_from_right, const std::string& title) {
-  cv::Mat img;
-  if (image.channels() == 1)
-    cv::cvtColor(image, img, cv::COLOR_GRAY2RGB);
-  else
-    img = image.clone();
+  cv::Mat img = to_rgb_copy(image);
   if (d.stripe.found) cv::line(img, d.stripe.line_start, d.stripe.line_end, cv::Scalar(255, 0, 255), 1, cv::LINE_AA);
   const int selected = rank_from_right >= 0 && rank_from_right < static_cast<int>(d.ranking.size())
                            ? d.ranking[static_cast<size_t>(rank_from_right)]

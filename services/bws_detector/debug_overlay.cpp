@@ -6,15 +6,12 @@
 #include <opencv2/imgproc.hpp>
 
 #include "common/image_caption.h"
+#include "common/image_conversion.h"
 
 namespace bookgrasp::bws {
 
 cv::Mat draw_bws_overlay(const cv::Mat& left, const BwsOutput& r, const std::string& title) {
-  cv::Mat img;
-  if (left.channels() == 1)
-    cv::cvtColor(left, img, cv::COLOR_GRAY2RGB);
-  else
-    img = left.clone();
+  cv::Mat img = to_rgb_copy(left);
   const cv::Mat& lab = r.segmentation.labels;
   if (lab.empty() || lab.size() != img.size()) return img;
   const size_t K = r.segmentation.regions.size();

@@ -93,6 +93,20 @@ std::string fmt(const char* f, double a) {
   return b;
 }
 
+/// The pose in the world of MuJoCo body `body` (after mj_forward / a step).
+Eigen::Isometry3d body_pose(const mjData* d, int body) {
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) pose.linear()(r, c) = d->xmat[9 * body + 3 * r + c];
+  pose.translation() = Eigen::Vector3d(d->xpos[3 * body], d->xpos[3 * body + 1], d->xpos[3 * body + 2]);
+  return pose;
+}
+
+/// The position in the world of MuJoCo site `site`.
+Eigen::Vector3d site_position(const mjData* d, int site) {
+  return Eigen::Vector3d(d->site_xpos[3 * site], d->site_xpos[3 * site + 1], d->site_xpos[3 * site + 2]);
+}
+
 }  // namespace
 
 struct FullCycleHarness::Impl {
@@ -434,11 +448,8 @@ struct FullCycleHarness::Impl {
     const int body = mj_name2id(mm, mjOBJ_BODY, ("book_" + std::to_string(target_book_id)).c_str());
     const int site = mj_name2id(mm, mjOBJ_SITE, "gripper");
     if (body < 0 || site < 0) return;
-    Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
-    for (int r = 0; r < 3; ++r)
-      for (int c = 0; c < 3; ++c) pose.linear()(r, c) = dd->xmat[9 * body + 3 * r + c];
-    pose.translation() = Eigen::Vector3d(dd->xpos[3 * body], dd->xpos[3 * body + 1], dd->xpos[3 * body + 2]);
-    const Eigen::Vector3d tcp(dd->site_xpos[3 * site], dd->site_xpos[3 * site + 1], dd->site_xpos[3 * site + 2]);
+    const Eigen::Isometry3d pose = body_pose(dd, body);
+    const Eigen::Vector3d tcp = site_position(dd, site);
     const Eigen::Vector3d in_book = pose.inverse() * tcp;
     const Eigen::Vector3d in_cart = scene.cart_pose.inverse() * tcp;
     double h = 0, d = 0;
@@ -527,13 +538,9 @@ struct FullCycleHarness::Impl {
     const int site = mj_name2id(mm, mjOBJ_SITE, "gripper");
     if (body < 0 || site < 0) return;
     const Eigen::Isometry3d inv = scene.holder_support_pose.inverse();
-    const Eigen::Vector3d b = inv * Eigen::Vector3d(dd->xpos[3 * body], dd->xpos[3 * body + 1], dd->xpos[3 * body + 2]);
-    const Eigen::Vector3d tcp =
-        inv * Eigen::Vector3d(dd->site_xpos[3 * site], dd->site_xpos[3 * site + 1], dd->site_xpos[3 * site + 2]);
-    Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
-    for (int r = 0; r < 3; ++r)
-      for (int c = 0; c < 3; ++c) pose.linear()(r, c) = dd->xmat[9 * body + 3 * r + c];
-    pose.translation() = Eigen::Vector3d(dd->xpos[3 * body], dd->xpos[3 * body + 1], dd->xpos[3 * body + 2]);
+    const Eigen::Isometry3d pose = body_pose(dd, body);
+    const Eigen::Vector3d b = inv * pose.translation();
+    const Eigen::Vector3d tcp = inv * site_position(dd, site);
     Eigen::Vector3d lo = Eigen::Vector3d::Constant(1e9), hi = Eigen::Vector3d::Constant(-1e9);
     for (const auto& bk : scene.books)
       if (bk.id == target_book_id)

@@ -51,6 +51,17 @@ JointTrajectory move(const Eigen::VectorXd& from, const Eigen::VectorXd& to, dou
 
 constexpr int64_t kT0 = 1000000000;
 
+// Runs the driver from kT0 for 1 s at 100 Hz with a heartbeat each step; returns the last setpoint.
+DriverSetpoint stream_for_one_second(ArmDriverCore& d) {
+  DriverSetpoint sp;
+  d.update(kT0);
+  for (int64_t t = kT0 + 10000; t <= kT0 + 1000000; t += 10000) {
+    d.heartbeat();
+    sp = d.update(t);
+  }
+  return sp;
+}
+
 TEST(ArmDriverCore, RefusesCommandsBeforeAnyMeasurement) {
   ArmDriverCore d = make_core();
   EXPECT_NE(d.command_trajectory(move(home(), home(), 1.0), 1).find("no measurement"), std::string::npos);
@@ -138,12 +149,7 @@ TEST(ArmDriverCore, ATrajectoryFromTheMeasuredStateIsAcceptedWhileTheArmCatchesU
   Eigen::Matrix<double, 6, 1> tw;
   tw << 0.1, 0.0, 0.0, 0, 0, 0;
   ASSERT_EQ(d.command_cartesian_velocity(tw, "base", 3), "");
-  DriverSetpoint sp;
-  d.update(kT0);
-  for (int64_t t = kT0 + 10000; t <= kT0 + 1000000; t += 10000) {
-    d.heartbeat();
-    sp = d.update(t);
-  }
+  const DriverSetpoint sp = stream_for_one_second(d);
   d.command_stop("servo finished");
   // The arm lags the setpoint by 0.04 rad on every joint that moved.
   Eigen::VectorXd lagging = sp.q;
@@ -184,12 +190,7 @@ TEST(ArmDriverCore, CartesianVelocityMovesTheGripperAsCommanded) {
   Eigen::Matrix<double, 6, 1> tw;
   tw << 0.02, -0.01, 0.0, 0, 0, 0;  // 2 cm/s forward, 1 cm/s to the right
   ASSERT_EQ(d.command_cartesian_velocity(tw, "base", 3), "");
-  DriverSetpoint sp;
-  d.update(kT0);
-  for (int64_t t = kT0 + 10000; t <= kT0 + 1000000; t += 10000) {
-    d.heartbeat();
-    sp = d.update(t);
-  }
+  const DriverSetpoint sp = stream_for_one_second(d);
   const Eigen::Vector3d p1 = d.kinematics().tip_pose(sp.q).translation();
   EXPECT_NEAR(p1.x() - p0.x(), 0.02, 0.001);
   EXPECT_NEAR(p1.y() - p0.y(), -0.01, 0.001);
