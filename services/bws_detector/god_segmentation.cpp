@@ -31,7 +31,9 @@ inline float direction_deg(float dx, float dy) {
   return a;
 }
 
-inline bool valid_value(float v) { return std::isfinite(v) && v > 0.f; }
+inline bool valid_value(float v) {
+  return std::isfinite(v) && v > 0.f;
+}
 
 struct UnionFind {
   std::vector<int> parent;
@@ -54,6 +56,63 @@ struct UnionFind {
   }
 };
 
+/// Sums of a point set in double (count, sums, the six distinct products), accumulated point by
+/// point exactly as PointMoments::add does (same products, same order), in 80 bytes.
+struct Sums {
+  double n = 0.0, x = 0.0, y = 0.0, z = 0.0, xx = 0.0, xy = 0.0, xz = 0.0, yy = 0.0, yz = 0.0, zz = 0.0;
+  void add(double px, double py, double pz) {
+    n += 1.0;
+    x += px;
+    y += py;
+    z += pz;
+    xx += px * px;
+    xy += px * py;
+    xz += px * pz;
+    yy += py * py;
+    yz += py * pz;
+    zz += pz * pz;
+  }
+  PointMoments moments() const {
+    PointMoments m;
+    m.n = n;
+    m.sum = Eigen::Vector3d(x, y, z);
+    m.sum_outer << xx, xy, xz, xy, yy, yz, xz, yz, zz;
+    return m;
+  }
+};
+
+inline bool finite3(const cv::Vec3f& q) {
+  return std::isfinite(q[0]) && std::isfinite(q[1]) && std::isfinite(q[2]);
+}
+
+/// god_bins(compute_god_features(image, s, flat), B, jump) without the two float images (same arithmetic,
+/// and no arctangent for jump pixels, which do not vote).
+cv::Mat god_bins_of_image(const cv::Mat& image, int s, double flat_mgod_max, int B, double jump_mgod_min) {
+  cv::Mat bins(image.size(), CV_8U, cv::Scalar(255));
+  const float flat = float(flat_mgod_max), jump = float(jump_mgod_min), w = 360.f / float(B);
+  for (int y = s; y < image.rows - s; ++y) {
+    const float* up = image.ptr<float>(y - s);
+    const float* mid = image.ptr<float>(y);
+    const float* dn = image.ptr<float>(y + s);
+    uint8_t* b = bins.ptr<uint8_t>(y);
+    for (int x = s; x < image.cols - s; ++x) {
+      const float r = mid[x + s], l = mid[x - s], d = dn[x], u = up[x];
+      if (!(valid_value(mid[x]) && valid_value(r) && valid_value(l) && valid_value(d) && valid_value(u))) continue;
+      const float dx = r - l, dy = d - u;
+      const float m = std::sqrt(dx * dx + dy * dy);
+      if (!(m <= jump)) continue;
+      if (m <= flat) {
+        b[x] = uint8_t(B);
+      } else {
+        int k = int(direction_deg(dx, dy) / w + 0.5f);
+        if (k >= B) k -= B;
+        b[x] = uint8_t(k);
+      }
+    }
+  }
+  return bins;
+}
+
 }  // namespace
 
 GodParams GodParams::from_config(const Config& c) {
@@ -64,8 +123,8 @@ GodParams GodParams::from_config(const Config& c) {
   p.window_size = c.get_int("window_size", 1, 101);
   p.jump_mgod_min = c.get_double("jump_mgod_min", 0.0, 1e9);
   p.merge_distance = c.get_double("merge_distance", 0.0, 1e9);
-  p.merge_space = c.get_choice("merge_space", {"image", "points"}) == "image" ? MergeSpace::kImage
-                                                                             : MergeSpace::kPoints;
+  p.merge_space =
+      c.get_choice("merge_space", {"image", "points"}) == "image" ? MergeSpace::kImage : MergeSpace::kPoints;
   p.merge_max_angle_deg = c.get_double("merge_max_angle_deg", 0.0, 90.0);
   p.merge_angle_min_px = c.get_int("merge_angle_min_px", 3, 100000000);
   p.adjacency_radius_px = c.get_int("adjacency_radius_px", 1, 16);
@@ -242,8 +301,7 @@ cv::Mat connected_regions(const cv::Mat& cls, int* count) {
   return lab;
 }
 
-SegmentationResult segment_god(const cv::Mat& image, const cv::Mat& points, const GodParams& params,
-                               GodDebug* debug) {
+SegmentationResult segment_god(const cv::Mat& image, const cv::Mat& points, const GodParams& params, GodDebug* debug) {
   params.validate();
   if (image.type() != CV_32F || image.empty())
     throw std::invalid_argument("segment_god: image must be a non-empty CV_32F depth or disparity image");
@@ -254,54 +312,86 @@ SegmentationResult segment_god(const cv::Mat& image, const cv::Mat& points, cons
 
   GodDebug local;
   GodDebug& dbg = debug ? *debug : local;
-  dbg.features = compute_god_features(image, params.gradient_step, params.flat_mgod_max);
-  dbg.bins = god_bins(dbg.features, params.direction_bins, params.jump_mgod_min);
+  if (debug) {
+    dbg.features = compute_god_features(image, params.gradient_step, params.flat_mgod_max);
+    dbg.bins = god_bins(dbg.features, params.direction_bins, params.jump_mgod_min);
+  } else {
+    // Same bins without the DGoD/MGoD images (only the debug output needs them).
+    dbg.bins = god_bins_of_image(image, params.gradient_step, params.flat_mgod_max, params.direction_bins,
+                                 params.jump_mgod_min);
+  }
   dbg.clusters = vote_clusters(dbg.bins, params.direction_bins + 1, params.window_size);
   int count = 0;
   dbg.initial_labels = connected_regions(dbg.clusters, &count);
   dbg.initial_count = count;
-
-  const cv::Mat merge_pts = params.merge_space == MergeSpace::kImage ? image_space_points(image) : points;
+  const cv::Mat& init = dbg.initial_labels;
   const int W = image.cols, H = image.rows;
 
-  const cv::Mat out_pts = points.empty() ? (params.merge_space == MergeSpace::kImage ? merge_pts
-                                                                                   : image_space_points(image))
-                                         : points;
-  // Moments of every initial segment in merge space and in the output points' space.
-  std::vector<PointMoments> mom(size_t(count) + 1), omom(size_t(count) + 1);
-  const bool same = out_pts.data == merge_pts.data;
-  for (int y = 0; y < H; ++y) {
-    const int* l = dbg.initial_labels.ptr<int>(y);
-    const cv::Vec3f* p = merge_pts.ptr<cv::Vec3f>(y);
-    const cv::Vec3f* q = out_pts.ptr<cv::Vec3f>(y);
-    for (int x = 0; x < W; ++x) {
-      if (l[x] <= 0) continue;
-      if (std::isfinite(p[x][0]) && std::isfinite(p[x][1]) && std::isfinite(p[x][2]))
-        mom[size_t(l[x])].add(Eigen::Vector3d(p[x][0], p[x][1], p[x][2]));
-      if (!same && std::isfinite(q[x][0]) && std::isfinite(q[x][1]) && std::isfinite(q[x][2]))
-        omom[size_t(l[x])].add(Eigen::Vector3d(q[x][0], q[x][1], q[x][2]));
+  // Merge-space point of a pixel: (x, y, value) in image space (no (x, y, value) image is built), else
+  // the caller's point. The output planes are fitted to the caller's points, or to (x, y, value).
+  const bool image_space = params.merge_space == MergeSpace::kImage;
+  const bool same = points.empty() || !image_space;  // output points == merge points
+  const auto merge_point = [&](int x, int y, Eigen::Vector3d* v) {
+    if (image_space) {
+      const float d = image.ptr<float>(y)[x];
+      if (!valid_value(d)) return false;
+      *v = Eigen::Vector3d(double(x), double(y), double(d));
+      return true;
+    }
+    const cv::Vec3f& q = points.ptr<cv::Vec3f>(y)[x];
+    if (!finite3(q)) return false;
+    *v = Eigen::Vector3d(q[0], q[1], q[2]);
+    return true;
+  };
+
+  // Moments of every initial segment in merge space and in the output points' space (raster order,
+  // the same sums PointMoments::add would make).
+  std::vector<PointMoments> mom(size_t(count) + 1), omom;
+  {
+    std::vector<Sums> ms(size_t(count) + 1), os(same ? 0 : size_t(count) + 1);
+    for (int y = 0; y < H; ++y) {
+      const int* l = init.ptr<int>(y);
+      const float* v = image.ptr<float>(y);
+      const cv::Vec3f* q = points.empty() ? nullptr : points.ptr<cv::Vec3f>(y);
+      for (int x = 0; x < W; ++x) {
+        const int lab = l[x];
+        if (lab <= 0) continue;
+        if (image_space) {
+          if (valid_value(v[x])) ms[size_t(lab)].add(double(x), double(y), double(v[x]));
+        } else if (finite3(q[x])) {
+          ms[size_t(lab)].add(q[x][0], q[x][1], q[x][2]);
+        }
+        if (!same && finite3(q[x])) os[size_t(lab)].add(q[x][0], q[x][1], q[x][2]);
+      }
+    }
+    for (int i = 1; i <= count; ++i) mom[size_t(i)] = ms[size_t(i)].moments();
+    if (same) {
+      omom = mom;
+    } else {
+      omom.resize(size_t(count) + 1);
+      for (int i = 1; i <= count; ++i) omom[size_t(i)] = os[size_t(i)].moments();
     }
   }
-  if (same) omom = mom;
 
   // Adjacency within the Chebyshev radius (forward half of the window). When a pixel has the label of
   // its left neighbour, the pairs of its forward half-window are those of the left neighbour's plus
-  // the entering column x + R (rows y..y+R): only that column is scanned. Consecutive duplicates are
-  // not pushed.
+  // the entering column x + R (rows y..y+R): only that column is scanned. An edge is not pushed again
+  // while it is in a small direct-mapped cache of recent edges (most repeats come from the next rows).
   const int R = params.adjacency_radius_px;
   std::vector<uint64_t> edges;
-  edges.reserve(size_t(count) * 16);
-  uint64_t last_edge = 0;
+  edges.reserve(size_t(count) * 4);
+  constexpr int kCacheBits = 11;
+  std::vector<uint64_t> recent(size_t(1) << kCacheBits, 0);  // 0 never is an edge (labels >= 1)
   const auto push = [&](int a, int b) {
     const uint64_t lo = uint64_t(std::min(a, b)), hi = uint64_t(std::max(a, b));
     const uint64_t e = (lo << 32) | hi;
-    if (e != last_edge) {
-      edges.push_back(e);
-      last_edge = e;
-    }
+    uint64_t& slot = recent[size_t((e * 0x9E3779B97F4A7C15ull) >> (64 - kCacheBits))];
+    if (slot == e) return;
+    slot = e;
+    edges.push_back(e);
   };
   for (int y = 0; y < H; ++y) {
-    const int* l = dbg.initial_labels.ptr<int>(y);
+    const int* l = init.ptr<int>(y);
     for (int x = 0; x < W; ++x) {
       const int a = l[x];
       if (a == 0) continue;
@@ -309,13 +399,13 @@ SegmentationResult segment_god(const cv::Mat& image, const cv::Mat& points, cons
         const int xx = x + R;
         if (xx >= W) continue;
         for (int dy = 0; dy <= R && y + dy < H; ++dy) {
-          const int b = dbg.initial_labels.ptr<int>(y + dy)[xx];
+          const int b = init.ptr<int>(y + dy)[xx];
           if (b != 0 && b != a) push(a, b);
         }
         continue;
       }
       for (int dy = 0; dy <= R && y + dy < H; ++dy) {
-        const int* ln = dbg.initial_labels.ptr<int>(y + dy);
+        const int* ln = init.ptr<int>(y + dy);
         for (int dx = (dy == 0 ? 1 : -R); dx <= R; ++dx) {
           const int xx = x + dx;
           if (xx < 0 || xx >= W) continue;
@@ -333,6 +423,7 @@ SegmentationResult segment_god(const cv::Mat& image, const cv::Mat& points, cons
   UnionFind uf(size_t(count) + 1);
   std::vector<Plane> planes(size_t(count) + 1);
   std::vector<Plane> oplanes(size_t(count) + 1);
+  // Fitted lazily (most initial segments are never the larger region of a pair or gated).
   std::vector<uint8_t> fitted(size_t(count) + 1, 0);  // bit 0: planes[i] current, bit 1: oplanes[i] current
   const auto plane = [&](int i) -> const Plane& {
     if (!(fitted[size_t(i)] & 1)) {
@@ -348,21 +439,18 @@ SegmentationResult segment_god(const cv::Mat& image, const cv::Mat& points, cons
     }
     return oplanes[size_t(i)];
   };
-  for (int i = 1; i <= count; ++i) {
-    // Fitted lazily (most initial segments are never the larger region of a pair or gated).
-    fitted[size_t(i)] = 0;
-  }
   const double cos_gate = std::cos(params.merge_max_angle_deg * M_PI / 180.0);
   const double gate_n = double(params.merge_angle_min_px);
   const double T = params.merge_distance;
   std::vector<std::tuple<double, int, int>> cand;
   std::vector<char> touched(size_t(count) + 1, 0);
+  std::vector<uint64_t> root_edges;
+  root_edges.reserve(edges.size());
   dbg.merges = 0;
   dbg.merge_rounds = 0;
   for (;;) {
     cand.clear();
-    std::vector<uint64_t> root_edges;
-    root_edges.reserve(edges.size());
+    root_edges.clear();
     for (uint64_t e : edges) {
       int a = uf.find(int(e >> 32)), b = uf.find(int(e & 0xffffffffu));
       if (a == b) continue;
@@ -377,7 +465,7 @@ SegmentationResult segment_god(const cv::Mat& image, const cv::Mat& points, cons
     auto merge_cost = [&](int a, int b) {
       const bool a_large = mom[size_t(a)].n >= mom[size_t(b)].n;
       const int L = a_large ? a : b, S = a_large ? b : a;
-      if (!plane(L).valid || mom[size_t(S)].n <= 0.0) return -1.0;
+      if (mom[size_t(S)].n <= 0.0 || !plane(L).valid) return -1.0;
       const double d = rms_distance(mom[size_t(S)], plane(L));
       if (!(d < T)) return -1.0;
       if (omom[size_t(a)].n >= gate_n && omom[size_t(b)].n >= gate_n && oplane(a).valid && oplane(b).valid &&
@@ -413,56 +501,93 @@ SegmentationResult segment_god(const cv::Mat& image, const cv::Mat& points, cons
     if (merged_this_round == 0) break;
   }
 
+  // Merged labels, numbered 1..K in raster order of their first pixel. A root is the smallest initial
+  // label of its set, i.e. the set's first initial segment in raster order, so this numbering keeps the
+  // order of the roots (the growth's tie-break) and describe_regions gets K instead of `count` slots.
   cv::Mat labels(image.size(), CV_32S);
+  std::vector<int> id_of_initial(size_t(count) + 1, 0), id_of_root(size_t(count) + 1, 0);
+  std::vector<int> root_of_id(1, 0);
   for (int y = 0; y < H; ++y) {
-    const int* l = dbg.initial_labels.ptr<int>(y);
+    const int* l = init.ptr<int>(y);
     int* o = labels.ptr<int>(y);
-    for (int x = 0; x < W; ++x) o[x] = l[x] > 0 ? uf.find(l[x]) : 0;
+    for (int x = 0; x < W; ++x) {
+      const int a = l[x];
+      if (a <= 0) {
+        o[x] = 0;
+        continue;
+      }
+      int& id = id_of_initial[size_t(a)];
+      if (id == 0) {
+        const int root = uf.find(a);
+        int& rid = id_of_root[size_t(root)];
+        if (rid == 0) {
+          rid = int(root_of_id.size());
+          root_of_id.push_back(root);
+        }
+        id = rid;
+      }
+      o[x] = id;
+    }
   }
 
-  // Boundary growth: unlabeled pixels with a valid point join the 8-neighbour region whose plane
-  // is nearest, if within merge_distance.
-  for (int g = 0; g < params.boundary_growth_px; ++g) {
-    cv::Mat next = labels.clone();
-    int grown = 0;
-    for (int y = 0; y < H; ++y) {
-      const int* l = labels.ptr<int>(y);
-      const cv::Vec3f* p = merge_pts.ptr<cv::Vec3f>(y);
-      int* o = next.ptr<int>(y);
-      for (int x = 0; x < W; ++x) {
-        if (l[x] != 0) continue;
-        const cv::Vec3f q = p[x];
-        if (!(std::isfinite(q[0]) && std::isfinite(q[1]) && std::isfinite(q[2]))) continue;
-        const Eigen::Vector3d v(q[0], q[1], q[2]);
+  // Boundary growth: unlabeled pixels with a valid point join the 8-neighbour region whose plane is
+  // nearest, if within boundary_growth_distance (ties: the smaller label). Each step reads the labels
+  // of the previous one. A pixel can only change in a step if a neighbour grew in the step before, so
+  // after the first step (every unlabeled pixel) only the neighbours of the grown pixels are examined.
+  if (params.boundary_growth_px > 0) {
+    std::vector<int> todo, next_todo;
+    std::vector<std::pair<int, int>> grown;  // (pixel index, label)
+    int* lab = labels.ptr<int>(0);           // continuous (created above)
+    Eigen::Vector3d v;
+    for (int y = 0; y < H; ++y)
+      for (int x = 0; x < W; ++x)
+        if (lab[y * W + x] == 0 && merge_point(x, y, &v)) todo.push_back(y * W + x);
+    for (int g = 0; g < params.boundary_growth_px && !todo.empty(); ++g) {
+      grown.clear();
+      for (const int idx : todo) {
+        const int y = idx / W, x = idx - y * W;
+        if (!merge_point(x, y, &v)) continue;
         int best = 0;
         double best_d = params.boundary_growth_distance;
         for (int dy = -1; dy <= 1; ++dy) {
           const int yy = y + dy;
           if (yy < 0 || yy >= H) continue;
-          const int* ln = labels.ptr<int>(yy);
+          const int* ln = lab + yy * W;
           for (int dx = -1; dx <= 1; ++dx) {
             const int xx = x + dx;
             if (xx < 0 || xx >= W) continue;
             const int b = ln[xx];
-            if (b == 0 || b == best || !plane(b).valid) continue;
-            const double d = std::fabs(plane(b).normal.dot(v) - plane(b).offset);
+            if (b <= 0 || b == best) continue;
+            const Plane& pl = plane(root_of_id[size_t(b)]);
+            if (!pl.valid) continue;
+            const double d = std::fabs(pl.normal.dot(v) - pl.offset);
             if (d < best_d || (d == best_d && best != 0 && b < best)) {
               best_d = d;
               best = b;
             }
           }
         }
-        if (best) {
-          o[x] = best;
-          ++grown;
-        }
+        if (best) grown.emplace_back(idx, best);
       }
+      if (grown.empty()) break;
+      for (const auto& [idx, b] : grown) lab[idx] = b;
+      // Next step's pixels: unlabeled neighbours of this step's grown pixels, each once (-1 while queued).
+      next_todo.clear();
+      for (const auto& gi : grown) {
+        const int y = gi.first / W, x = gi.first - y * W;
+        for (int yy = std::max(0, y - 1); yy <= std::min(H - 1, y + 1); ++yy)
+          for (int xx = std::max(0, x - 1); xx <= std::min(W - 1, x + 1); ++xx)
+            if (lab[yy * W + xx] == 0) {
+              lab[yy * W + xx] = -1;
+              next_todo.push_back(yy * W + xx);
+            }
+      }
+      for (const int idx : next_todo) lab[idx] = 0;
+      todo.swap(next_todo);
     }
-    labels = next;
-    if (grown == 0) break;
   }
 
-  return describe_regions(labels, out_pts, params.min_region_px);
+  return describe_regions(labels, points.empty() ? image_space_points(image) : points, params.min_region_px);
 }
 
 }  // namespace bookgrasp::bws
