@@ -11,6 +11,10 @@
 
 #include "common/config.h"
 
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
 namespace bookgrasp::bws {
 
 namespace {
@@ -83,6 +87,26 @@ struct Sums {
 
 inline bool finite3(const cv::Vec3f& q) {
   return std::isfinite(q[0]) && std::isfinite(q[1]) && std::isfinite(q[2]);
+}
+
+/// Removes repeated edges (lo << 32 | hi, 1 <= lo < hi <= count) in O(E + count) by a counting sort on
+/// lo; the order becomes by lo, then by first occurrence (the merging needs the set only: its candidates
+/// are sorted by (distance, a, b)).
+void unique_edges(std::vector<uint64_t>& edges, int count, std::vector<uint64_t>& tmp, std::vector<int>& start,
+                  std::vector<int>& stamp) {
+  start.assign(size_t(count) + 2, 0);
+  for (const uint64_t e : edges) ++start[size_t(e >> 32) + 1];
+  for (size_t i = 1; i < start.size(); ++i) start[i] += start[i - 1];
+  tmp.resize(edges.size());
+  for (const uint64_t e : edges) tmp[size_t(start[size_t(e >> 32)]++)] = e;
+  stamp.assign(size_t(count) + 1, 0);
+  edges.clear();
+  for (const uint64_t e : tmp) {
+    const int lo = int(e >> 32), hi = int(e & 0xffffffffu);
+    if (stamp[size_t(hi)] == lo) continue;
+    stamp[size_t(hi)] = lo;
+    edges.push_back(e);
+  }
 }
 
 /// god_bins(compute_god_features(image, s, flat), B, jump) without the two float images (same arithmetic,
@@ -204,52 +228,86 @@ cv::Mat god_bins(const GodFeatures& f, int B, double jump_mgod_min) {
   return bins;
 }
 
+namespace {
+
+/// Histogram lanes are counted in 16 bits (n * n <= 101 * 101 votes), padded to whole vectors of 8.
+using Count = uint16_t;
+
+#if defined(__SSE2__)
+inline void hist_add(Count* h, const Count* c, int K) {
+  for (int k = 0; k < K; k += 8) {
+    const __m128i a = _mm_loadu_si128(reinterpret_cast<const __m128i*>(h + k));
+    _mm_storeu_si128(reinterpret_cast<__m128i*>(h + k),
+                     _mm_add_epi16(a, _mm_loadu_si128(reinterpret_cast<const __m128i*>(c + k))));
+  }
+}
+inline void hist_sub(Count* h, const Count* c, int K) {
+  for (int k = 0; k < K; k += 8) {
+    const __m128i a = _mm_loadu_si128(reinterpret_cast<const __m128i*>(h + k));
+    _mm_storeu_si128(reinterpret_cast<__m128i*>(h + k),
+                     _mm_sub_epi16(a, _mm_loadu_si128(reinterpret_cast<const __m128i*>(c + k))));
+  }
+}
+/// Index of the largest count, the lowest index on ties. Lanes past the real bins hold 0 and the
+/// pixel's own bin has at least its own vote, so they never win. Counts < 32768: signed max is exact.
+inline int hist_argmax(const Count* h, int K) {
+  __m128i mx = _mm_loadu_si128(reinterpret_cast<const __m128i*>(h));
+  for (int k = 8; k < K; k += 8) mx = _mm_max_epi16(mx, _mm_loadu_si128(reinterpret_cast<const __m128i*>(h + k)));
+  mx = _mm_max_epi16(mx, _mm_shuffle_epi32(mx, _MM_SHUFFLE(1, 0, 3, 2)));
+  mx = _mm_max_epi16(mx, _mm_shuffle_epi32(mx, _MM_SHUFFLE(2, 3, 0, 1)));
+  mx =
+      _mm_max_epi16(mx, _mm_shufflelo_epi16(_mm_shufflehi_epi16(mx, _MM_SHUFFLE(2, 3, 0, 1)), _MM_SHUFFLE(2, 3, 0, 1)));
+  for (int k = 0; k < K; k += 8) {
+    const int m = _mm_movemask_epi8(_mm_cmpeq_epi16(_mm_loadu_si128(reinterpret_cast<const __m128i*>(h + k)), mx));
+    if (m) return k + __builtin_ctz(unsigned(m)) / 2;
+  }
+  return 0;
+}
+#else
+inline void hist_add(Count* h, const Count* c, int K) {
+  for (int k = 0; k < K; ++k) h[k] = Count(h[k] + c[k]);
+}
+inline void hist_sub(Count* h, const Count* c, int K) {
+  for (int k = 0; k < K; ++k) h[k] = Count(h[k] - c[k]);
+}
+inline int hist_argmax(const Count* h, int K) {
+  int best = 0;
+  for (int k = 1; k < K; ++k)
+    if (h[k] > h[best]) best = k;
+  return best;
+}
+#endif
+
+}  // namespace
+
 cv::Mat vote_clusters(const cv::Mat& bins, int num_bins, int n) {
   if (bins.type() != CV_8U) throw std::invalid_argument("vote_clusters: bins must be CV_8U");
   if (n < 1 || n % 2 == 0) throw std::invalid_argument("vote_clusters: window_size must be odd");
   if (num_bins < 1 || num_bins > 255) throw std::invalid_argument("vote_clusters: num_bins must be in [1, 255]");
   const int W = bins.cols, H = bins.rows, r = n / 2;
-  const int K = (num_bins + 15) / 16 * 16;  // padded for vector adds
-  std::vector<uint16_t> col(size_t(W) * size_t(K), 0);
+  const int K = (num_bins + 7) / 8 * 8;  // whole vectors of 8 lanes
+  std::vector<Count> col(size_t(W) * size_t(K), 0);
   auto col_update = [&](int y, int delta) {
     const uint8_t* b = bins.ptr<uint8_t>(y);
     for (int x = 0; x < W; ++x)
-      if (b[x] < num_bins) col[size_t(x) * size_t(K) + b[x]] = uint16_t(col[size_t(x) * size_t(K) + b[x]] + delta);
+      if (b[x] < num_bins) col[size_t(x) * size_t(K) + b[x]] = Count(col[size_t(x) * size_t(K) + b[x]] + delta);
   };
   for (int y = 0; y <= std::min(r, H - 1); ++y) col_update(y, +1);
   cv::Mat out(bins.size(), CV_8U, cv::Scalar(255));
-  std::vector<uint16_t> hist(size_t(K), 0);  // n * n <= 101 * 101 votes fit in 16 bits
+  std::vector<Count> hist(size_t(K), 0);
   for (int y = 0; y < H; ++y) {
     if (y > 0) {
       if (y + r < H) col_update(y + r, +1);
       if (y - r - 1 >= 0) col_update(y - r - 1, -1);
     }
     std::fill(hist.begin(), hist.end(), 0);
-    for (int x = 0; x <= std::min(r, W - 1); ++x) {
-      const uint16_t* c = &col[size_t(x) * size_t(K)];
-      for (int k = 0; k < K; ++k) hist[size_t(k)] = uint16_t(hist[size_t(k)] + c[k]);
-    }
+    for (int x = 0; x <= std::min(r, W - 1); ++x) hist_add(hist.data(), &col[size_t(x) * size_t(K)], K);
     const uint8_t* b = bins.ptr<uint8_t>(y);
     uint8_t* o = out.ptr<uint8_t>(y);
     for (int x = 0; x < W; ++x) {
-      if (b[x] < num_bins) {
-        int best = 0;
-        uint16_t best_votes = hist[0];
-        for (int k = 1; k < num_bins; ++k)
-          if (hist[size_t(k)] > best_votes) {
-            best_votes = hist[size_t(k)];
-            best = k;
-          }
-        o[x] = uint8_t(best);
-      }
-      if (x + r + 1 < W) {
-        const uint16_t* c = &col[size_t(x + r + 1) * size_t(K)];
-        for (int k = 0; k < K; ++k) hist[size_t(k)] = uint16_t(hist[size_t(k)] + c[k]);
-      }
-      if (x - r >= 0) {
-        const uint16_t* c = &col[size_t(x - r) * size_t(K)];
-        for (int k = 0; k < K; ++k) hist[size_t(k)] = uint16_t(hist[size_t(k)] - c[k]);
-      }
+      if (b[x] < num_bins) o[x] = uint8_t(hist_argmax(hist.data(), K));
+      if (x + r + 1 < W) hist_add(hist.data(), &col[size_t(x + r + 1) * size_t(K)], K);
+      if (x - r >= 0) hist_sub(hist.data(), &col[size_t(x - r) * size_t(K)], K);
     }
   }
   return out;
@@ -373,11 +431,30 @@ SegmentationResult segment_god(const cv::Mat& image, const cv::Mat& points, cons
     }
   }
 
-  // Adjacency within the Chebyshev radius (forward half of the window). When a pixel has the label of
-  // its left neighbour, the pairs of its forward half-window are those of the left neighbour's plus
-  // the entering column x + R (rows y..y+R): only that column is scanned. An edge is not pushed again
-  // while it is in a small direct-mapped cache of recent edges (most repeats come from the next rows).
+  // Adjacency: two initial segments are adjacent when two of their pixels are within the Chebyshev
+  // radius R. Found on runs (maximal horizontal pieces of one label): a run and the later runs of its
+  // row that start within R of its end, and the runs of the next R rows that overlap its columns
+  // widened by R. An edge is not pushed again while it is in a small direct-mapped cache of recent
+  // edges (most repeats come from the next rows); the rest of the repeats go in unique_edges.
   const int R = params.adjacency_radius_px;
+  struct Run {
+    int x0, x1, label;
+  };
+  std::vector<Run> runs;
+  runs.reserve(size_t(count) * 8);
+  std::vector<size_t> row_start(size_t(H) + 1);
+  for (int y = 0; y < H; ++y) {
+    row_start[size_t(y)] = runs.size();
+    const int* l = init.ptr<int>(y);
+    for (int x = 0; x < W;) {
+      const int a = l[x];
+      int x1 = x;
+      while (x1 + 1 < W && l[x1 + 1] == a) ++x1;
+      if (a != 0) runs.push_back({x, x1, a});
+      x = x1 + 1;
+    }
+  }
+  row_start[size_t(H)] = runs.size();
   std::vector<uint64_t> edges;
   edges.reserve(size_t(count) * 4);
   constexpr int kCacheBits = 11;
@@ -391,32 +468,24 @@ SegmentationResult segment_god(const cv::Mat& image, const cv::Mat& points, cons
     edges.push_back(e);
   };
   for (int y = 0; y < H; ++y) {
-    const int* l = init.ptr<int>(y);
-    for (int x = 0; x < W; ++x) {
-      const int a = l[x];
-      if (a == 0) continue;
-      if (x > 0 && l[x - 1] == a) {
-        const int xx = x + R;
-        if (xx >= W) continue;
-        for (int dy = 0; dy <= R && y + dy < H; ++dy) {
-          const int b = init.ptr<int>(y + dy)[xx];
-          if (b != 0 && b != a) push(a, b);
-        }
-        continue;
-      }
-      for (int dy = 0; dy <= R && y + dy < H; ++dy) {
-        const int* ln = init.ptr<int>(y + dy);
-        for (int dx = (dy == 0 ? 1 : -R); dx <= R; ++dx) {
-          const int xx = x + dx;
-          if (xx < 0 || xx >= W) continue;
-          const int b = ln[xx];
-          if (b != 0 && b != a) push(a, b);
-        }
+    const size_t i0 = row_start[size_t(y)], i1 = row_start[size_t(y) + 1];
+    for (size_t i = i0; i < i1; ++i)
+      for (size_t k = i + 1; k < i1 && runs[k].x0 - runs[i].x1 <= R; ++k)
+        if (runs[k].label != runs[i].label) push(runs[i].label, runs[k].label);
+    for (int dy = 1; dy <= R && y + dy < H; ++dy) {
+      size_t j = row_start[size_t(y + dy)];
+      const size_t j1 = row_start[size_t(y + dy) + 1];
+      for (size_t i = i0; i < i1; ++i) {
+        const Run& u = runs[i];
+        while (j < j1 && runs[j].x1 < u.x0 - R) ++j;  // u.x0 grows with i: j only moves forward
+        for (size_t k = j; k < j1 && runs[k].x0 <= u.x1 + R; ++k)
+          if (runs[k].label != u.label) push(u.label, runs[k].label);
       }
     }
   }
-  std::sort(edges.begin(), edges.end());
-  edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
+  std::vector<uint64_t> edge_tmp;
+  std::vector<int> edge_start, edge_stamp;
+  unique_edges(edges, count, edge_tmp, edge_start, edge_stamp);
 
   // Iterative merging: each round merges the closest admissible pairs, each region at most once,
   // then refits; until a round merges nothing.
@@ -457,8 +526,7 @@ SegmentationResult segment_god(const cv::Mat& image, const cv::Mat& points, cons
       if (b < a) std::swap(a, b);
       root_edges.push_back((uint64_t(a) << 32) | uint64_t(b));
     }
-    std::sort(root_edges.begin(), root_edges.end());
-    root_edges.erase(std::unique(root_edges.begin(), root_edges.end()), root_edges.end());
+    unique_edges(root_edges, count, edge_tmp, edge_start, edge_stamp);
     edges.swap(root_edges);  // adjacency between current roots only
     // Distance of the smaller region's points to the larger region's plane, with the orientation gate;
     // a negative value means "may not merge".
