@@ -19,6 +19,7 @@ BwsDetectorSettings BwsDetectorSettings::from_config(const Config& root) {
   s.publish_debug_image = root.get<bool>("debug.publish_image");
   s.cart_marker_role = root.get<std::string>("cart.marker_role");
   s.max_pending_frames = root.get_int("pairing.max_pending_frames", 0, 100);
+  s.min_frame_interval_s = root.get_double("processing.min_frame_interval_s", 0.0, 3600.0);
   s.measure_processing_time = root.get<bool>("diagnostics.measure_processing_time");
   s.params = bws::BwsParams::from_config(root);
   return s;
@@ -188,6 +189,14 @@ void BwsDetectorNode::on_stereo(const stereo_frame_t& frame) {
 }
 
 void BwsDetectorNode::answer(const stereo_frame_t& frame) {
+  // Message time decides which frames are skipped, so a replay skips the same frames as the live run.
+  // Only answered frames count (a rejected or waiting frame does not hold the next one back), and a
+  // frame from before the last answer (a restarted source) is always taken.
+  if (last_answered_utime_ && frame.utime >= *last_answered_utime_ &&
+      double(frame.utime - *last_answered_utime_) < s_.min_frame_interval_s * 1e6) {
+    ++skipped_frames_;
+    return;
+  }
   book_corner_stereo_t out;
   image_t debug;
   const std::string why = process(frame, &out, &debug);
@@ -200,6 +209,7 @@ void BwsDetectorNode::answer(const stereo_frame_t& frame) {
       reject(s_.stereo_channel, why);
     return;
   }
+  last_answered_utime_ = frame.utime;
   publish(s_.corner_channel, out);
   if (s_.publish_debug_image) publish(s_.debug_image_channel, debug);
 }

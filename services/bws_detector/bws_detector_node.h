@@ -7,6 +7,9 @@
 /// the same message on the same channel with their name in `implementation`.
 /// A frame is answered with the cart marker from the same frame (MARKERS at its
 /// utime): it waits for it, up to pairing.max_pending_frames frames.
+/// Frames closer than processing.min_frame_interval_s (message time) to the
+/// last one answered are skipped: the shelf is still while BwS is needed, and
+/// the coordinator waits for one P1 after it asks.
 
 #include <cstdint>
 #include <deque>
@@ -34,6 +37,8 @@ struct BwsDetectorSettings {
   bool publish_debug_image = false;     ///< debug.publish_image
   std::string cart_marker_role;         ///< cart.marker_role: role of the cart marker in MARKERS
   int max_pending_frames = 3;           ///< pairing.max_pending_frames: frames held for their MARKERS (0 = none)
+  double min_frame_interval_s = 0;      ///< processing.min_frame_interval_s: frames closer than this in message time
+                                        ///< to the last frame answered are skipped (0 = answer every frame)
   bool measure_processing_time = true;  ///< diagnostics.measure_processing_time (wall-time *_ms fields)
   bws::BwsParams params;                ///< algorithm (service.implementation, disparity, god|pcl, selection, cart)
 
@@ -67,6 +72,10 @@ class BwsDetectorNode : public Component {
   /// evaluation and debugging; empty before the first.
   const bws::BwsOutput& last_output() const { return last_; }
 
+  /// Stereo frames skipped since the start because they came within
+  /// processing.min_frame_interval_s of the last frame answered.
+  int64_t skipped_frames() const { return skipped_frames_; }
+
  private:
   void on_stereo(const stereo_frame_t& frame);
   void on_markers(const marker_detections_t& msg);
@@ -76,6 +85,8 @@ class BwsDetectorNode : public Component {
   bws::CartMarkerTrack track_;
   std::deque<stereo_frame_t> pending_;  ///< frames waiting for their MARKERS, oldest first
   bws::BwsOutput last_;
+  std::optional<int64_t> last_answered_utime_;  ///< utime of the last frame answered (BOOK_CORNER_STEREO sent)
+  int64_t skipped_frames_ = 0;
 };
 
 }  // namespace bookgrasp

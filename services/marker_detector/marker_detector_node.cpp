@@ -20,6 +20,7 @@ MarkerDetectorSettings MarkerDetectorSettings::from_config(const Config& root) {
   s.output_channel = root.get<std::string>("channels.output");
   s.detector = TagDetectorParams::from_config(root.child("apriltag"));
   s.fallback_quad_sigma = root.get_double("apriltag.fallback_quad_sigma", 0.0, 5.0);
+  s.tracking = TagTrackingParams::from_config(root.child("tracking"));
   s.default_tag_size_m = root.get_double("tags.default_size_m", 0.005, 2.0);
   s.cart_ids = root.get<std::vector<int>>("tags.cart.ids");
   s.cart_tag_size_m = root.get_double("tags.cart.size_m", 0.005, 2.0);
@@ -97,15 +98,28 @@ bool intrinsics_from_calibration(const camera_calibration_t& c, int image_width,
   return true;
 }
 
+namespace {
+
+std::map<int, std::string> roles_of_ids(const MarkerDetectorSettings& s) {
+  std::map<int, std::string> roles;
+  for (int id : s.cart_ids) roles[id] = "cart";
+  for (int id : s.holder_ids) roles[id] = "holder";
+  return roles;
+}
+
+std::set<int> ids_with_a_role(const std::map<int, std::string>& roles) {
+  std::set<int> ids;
+  for (const auto& [id, role] : roles) ids.insert(id);
+  return ids;
+}
+
+}  // namespace
+
 MarkerDetectorNode::MarkerDetectorNode(const MarkerDetectorSettings& settings)
-    : Component("marker_detector", "apriltag3"), settings_(settings), detector_(settings.detector) {
-  if (settings_.fallback_quad_sigma > 0) {
-    TagDetectorParams p = settings_.detector;
-    p.quad_sigma = settings_.fallback_quad_sigma;
-    fallback_detector_.emplace(p);
-  }
-  for (int id : settings_.cart_ids) role_of_id_[id] = "cart";
-  for (int id : settings_.holder_ids) role_of_id_[id] = "holder";
+    : Component("marker_detector", "apriltag3"),
+      settings_(settings),
+      role_of_id_(roles_of_ids(settings)),
+      search_(settings.detector, settings.fallback_quad_sigma, settings.tracking, ids_with_a_role(role_of_id_)) {
   subscribe(settings_.input_channel, &MarkerDetectorNode::on_stereo);
 }
 
@@ -141,17 +155,9 @@ bool MarkerDetectorNode::process(const stereo_frame_t& frame, marker_detections_
   const std::string camera_frame =
       frame.left_calibration.frame.empty() ? frame.left.frame : frame.left_calibration.frame;
 
-  std::vector<TagDetection> detections = detector_.detect(gray);
-  if (fallback_detector_) {
-    // A cart or holder tag the first pass missed: search again with a blur (aliased or noisy edges,
-    // e.g. the rendered tags), and take the role tags it finds that the first pass did not.
-    std::set<int> missing;
-    for (const auto& [id, role] : role_of_id_) missing.insert(id);
-    for (const TagDetection& d : detections) missing.erase(d.id);
-    if (!missing.empty())
-      for (const TagDetection& d : fallback_detector_->detect(gray))
-        if (missing.count(d.id)) detections.push_back(d);
-  }
+  // A cart or holder tag the first pass misses is searched again with a blur (aliased or noisy edges,
+  // e.g. the rendered tags); between whole-image searches only the previous frame's tags' regions.
+  const std::vector<TagDetection> detections = search_.detect(gray, frame.left.utime).tags;
   out->utime = frame.left.utime;
   out->implementation = implementation();
   out->camera_frame = camera_frame;

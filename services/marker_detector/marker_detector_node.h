@@ -15,6 +15,7 @@
 #include "common/config.h"
 #include "services/marker_detector/tag_detector.h"
 #include "services/marker_detector/tag_pose.h"
+#include "services/marker_detector/tag_search.h"
 
 namespace bookgrasp {
 
@@ -25,6 +26,7 @@ struct MarkerDetectorSettings {
   TagDetectorParams detector;           ///< apriltag.*
   double fallback_quad_sigma = 0;       ///< apriltag.fallback_quad_sigma: a second pass with this blur when a cart or
                                         ///< holder id was not found (<= 0: no second pass)
+  TagTrackingParams tracking;           ///< tracking.*: region search around the previous frame's tags
   double default_tag_size_m = 0;        ///< tags.default_size_m: size of tags without a role
   std::vector<int> cart_ids;            ///< tags.cart.ids
   double cart_tag_size_m = 0;           ///< tags.cart.size_m
@@ -56,17 +58,18 @@ class MarkerDetectorNode : public Component {
   explicit MarkerDetectorNode(const MarkerDetectorSettings& settings);
 
   /// Detects markers in one stereo frame (left image); the core of the
-  /// handler, usable without a bus. Returns false and a reason for a frame
-  /// that cannot be processed.
+  /// handler, usable without a bus. Frames are expected in message-time
+  /// order: between whole-image searches only the regions around the
+  /// previous frame's tags are searched (TagSearch). Returns false and a
+  /// reason for a frame that cannot be processed.
   bool process(const stereo_frame_t& frame, marker_detections_t* out, std::string* reason);
 
  private:
   void on_stereo(const stereo_frame_t& frame);
 
   MarkerDetectorSettings settings_;
-  TagDetector detector_;
-  std::optional<TagDetector> fallback_detector_;  ///< the blurred second pass (fallback_quad_sigma > 0)
   std::map<int, std::string> role_of_id_;
+  TagSearch search_;  ///< whole-image and region search, with the blurred second pass for cart and holder tags
 };
 
 }  // namespace bookgrasp

@@ -91,12 +91,16 @@ std::vector<TagDetection> TagDetector::detect(const cv::Mat& gray) {
     out.push_back(d);
   }
   apriltag_detections_destroy(found);
-  std::sort(out.begin(), out.end(), [](const TagDetection& a, const TagDetection& b) {
+  sort_tag_detections(&out);
+  return out;
+}
+
+void sort_tag_detections(std::vector<TagDetection>* tags) {
+  std::sort(tags->begin(), tags->end(), [](const TagDetection& a, const TagDetection& b) {
     if (a.id != b.id) return a.id < b.id;
     if (a.center.x != b.center.x) return a.center.x < b.center.x;
     return a.center.y < b.center.y;
   });
-  return out;
 }
 
 }  // namespace bookgrasp

@@ -44,6 +44,10 @@ struct TagDetection {
   cv::Point2d center;  ///< image of the tag centre, pixels
 };
 
+/// Sorts detections by id, then centre x, then centre y (the order detect()
+/// returns them in).
+void sort_tag_detections(std::vector<TagDetection>* tags);
+
 /// The AprilTag detector. Not copyable (it owns the C detector and family);
 /// detect() is not re-entrant: use one instance per thread.
 class TagDetector {

@@ -43,6 +43,8 @@ struct Fixture {
     s.params.cart.shelf_max_cart = box_in_cart.translation() + scene.shelf_half_extent;
     s.publish_debug_image = true;
     s.measure_processing_time = false;
+    // These tests send one frame (one utime) several times; the frame-rate limit has its own test.
+    s.min_frame_interval_s = 0.0;
     return s;
   }
   Fixture() {
@@ -276,6 +278,47 @@ TEST_F(BwsNodeBadInput, WithTheMarkerDetectorSilentFramesAreHeldAtMostMaxPending
   ASSERT_EQ(col.corners.size(), 1u) << node->last_error();
   EXPECT_EQ(col.corners[0].utime, f.frame.utime + 100000);  // the oldest, with the nearest marker
   EXPECT_EQ(node->rejected_total(), 0);
+}
+
+// The shipped processing.min_frame_interval_s: frames within it of the last answered frame (message
+// time) are skipped, the first one at or after it is answered; a rejected frame holds nothing back, and
+// a frame from before the last answer (a restarted source) is answered at once.
+TEST_F(BwsNodeBadInput, FramesWithinTheMinimumIntervalOfTheLastAnswerAreSkipped) {
+  const Fixture& f = fixture();
+  BwsDetectorSettings st = f.settings("bws_detector.yaml");
+  st.min_frame_interval_s =
+      BwsDetectorSettings::from_config(Config::load_file(kConfigDir + "bws_detector.yaml")).min_frame_interval_s;
+  ASSERT_GT(st.min_frame_interval_s, 0.15);
+  Composition c;
+  BwsDetectorNode& n = c.add(std::make_unique<BwsDetectorNode>(st));
+  Collector got;
+  c.bus().subscribe("BOOK_CORNER_STEREO", &Collector::on_corner, &got);
+  const int64_t step = 100000;  // a 10 Hz camera
+  const int64_t interval = static_cast<int64_t>(st.min_frame_interval_s * 1e6);
+  const auto send = [&](int64_t utime, bool bad) {
+    stereo_frame_t fr = f.frame;
+    fr.utime = utime;
+    if (bad) fr.baseline_m = 0.0;
+    marker_detections_t m = f.markers;
+    m.utime = utime;
+    c.bus().publish("MARKERS", &m);
+    c.bus().publish("STEREO_IMAGES", &fr);
+    c.spin();
+  };
+  send(f.frame.utime, /*bad=*/true);  // rejected: does not count as an answer
+  send(f.frame.utime + step, false);  // answered
+  std::vector<int64_t> expected{f.frame.utime + step};
+  for (int64_t t = f.frame.utime + 2 * step; t <= f.frame.utime + step + interval + step; t += step) {
+    send(t, false);
+    if (t - expected.back() >= interval) expected.push_back(t);
+  }
+  ASSERT_EQ(expected.size(), 2u);
+  send(f.frame.utime - 20 * step, false);  // the source restarted: answered at once
+  expected.push_back(f.frame.utime - 20 * step);
+  ASSERT_EQ(got.corners.size(), expected.size()) << n.last_error();
+  for (size_t i = 0; i < expected.size(); ++i) EXPECT_EQ(got.corners[i].utime, expected[i]) << i;
+  EXPECT_EQ(n.skipped_frames(), interval / step);
+  EXPECT_EQ(n.rejected_total(), 1);
 }
 
 TEST_F(BwsNodeBadInput, AMarkerFromBeforeTheStereoSourceRestartedIsDroppedNotARejection) {

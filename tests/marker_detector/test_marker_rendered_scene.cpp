@@ -60,5 +60,30 @@ TEST(MarkerRenderedScene, TheFallbackPassFindsTheCartTagTheFirstPassMisses) {
   EXPECT_LT((found.translation() - truth.translation()).norm(), 0.02);
 }
 
+// The next frames (same view, 10 Hz) are searched only in regions around the tags found: the cart tag,
+// found by the blurred pass, is found there again (blurred pass on the region) at the same pose.
+TEST(MarkerRenderedScene, TheCartTagIsFoundAgainInItsRegionOnTheNextFrames) {
+  const MarkerDetectorSettings shipped = MarkerDetectorSettings::from_config(
+      Config::load_file(std::string(BOOKGRASP_SOURCE_DIR) + "/config/services/marker_detector.yaml"));
+  ASSERT_TRUE(shipped.tracking.enabled);
+  Rendered r = render(7);
+  MarkerDetectorNode node(shipped);
+  std::vector<pose_t> cart_poses;
+  for (int k = 0; k < 3; ++k) {
+    r.frame.utime = r.frame.left.utime = 1000000 + k * 100000;
+    marker_detections_t out;
+    std::string why;
+    ASSERT_TRUE(node.process(r.frame, &out, &why)) << why;
+    for (const marker_t& m : out.markers)
+      if (m.role == "cart") cart_poses.push_back(m.pose_in_base);
+    ASSERT_EQ(cart_poses.size(), size_t(k + 1)) << "frame " << k << ": no cart tag";
+  }
+  for (size_t k = 1; k < cart_poses.size(); ++k) {
+    const Eigen::Isometry3d a = pose_to_isometry(cart_poses[0]), b = pose_to_isometry(cart_poses[k]);
+    EXPECT_LT((a.translation() - b.translation()).norm(), 1e-4) << "frame " << k;
+    EXPECT_LT(Eigen::AngleAxisd(a.linear().transpose() * b.linear()).angle(), 1e-3) << "frame " << k;
+  }
+}
+
 }  // namespace
 }  // namespace bookgrasp

@@ -11,6 +11,7 @@
 
 #include "common/config.h"
 #include "services/marker_detector/tag_detector.h"
+#include "services/marker_detector/tag_search.h"
 
 namespace bookgrasp {
 namespace {
@@ -70,11 +71,9 @@ double max_corner_distance(const std::array<cv::Point2d, 4>& a, const std::array
 class ListedPhoto : public ::testing::TestWithParam<std::string> {};
 
 // Every listed tag is found, with each corner (in the listed order) within 2 px.
-void expect_listed_tags_found(const std::string& photo, const TagDetectorParams& params) {
+void expect_listed_tags_in(const std::string& photo, const std::vector<TagDetection>& found) {
   const std::vector<ListedTag> listed = read_listed(kData + photo + ".txt");
   ASSERT_FALSE(listed.empty());
-  TagDetector detector(params);
-  const std::vector<TagDetection> found = detector.detect(load_gray(photo + ".jpg"));
   std::set<size_t> used;
   for (const ListedTag& t : listed) {
     double best = 1e9;
@@ -97,6 +96,11 @@ void expect_listed_tags_found(const std::string& photo, const TagDetectorParams&
   }
 }
 
+void expect_listed_tags_found(const std::string& photo, const TagDetectorParams& params) {
+  TagDetector detector(params);
+  expect_listed_tags_in(photo, detector.detect(load_gray(photo + ".jpg")));
+}
+
 TEST_P(ListedPhoto, AllListedTagsFoundWithCornersWithin2px) {
   expect_listed_tags_found(GetParam(), reference_params());
 }
@@ -108,6 +112,18 @@ TEST_P(ListedPhoto, AllListedTagsFoundWithTheShippedQuadSigma) {
   p.quad_sigma = Config::load_file(std::string(BOOKGRASP_SOURCE_DIR) + "/config/services/marker_detector.yaml")
                      .get<double>("apriltag.quad_sigma");
   expect_listed_tags_found(GetParam(), p);
+}
+
+// The shipped tracking: the next frame, searched only in regions around the tags found, finds every
+// listed tag again within 2 px of its listed corners.
+TEST_P(ListedPhoto, AllListedTagsFoundAgainByTheRegionSearchOfTheNextFrame) {
+  const Config root = Config::load_file(std::string(BOOKGRASP_SOURCE_DIR) + "/config/services/marker_detector.yaml");
+  TagSearch search(reference_params(), 0.0, TagTrackingParams::from_config(root.child("tracking")), {});
+  const cv::Mat gray = load_gray(GetParam() + ".jpg");
+  ASSERT_EQ(search.detect(gray, 0).mode, TagSearchMode::kFull);
+  const TagSearchResult next = search.detect(gray, 100000);
+  EXPECT_EQ(next.mode, TagSearchMode::kRegions);
+  expect_listed_tags_in(GetParam(), next.tags);
 }
 
 INSTANTIATE_TEST_SUITE_P(NasaSwarmathon, ListedPhoto,
