@@ -5,6 +5,7 @@
 #include <limits>
 #include <sstream>
 #include <stdexcept>
+#include <tuple>
 #include <utility>
 #include <vector>
 
@@ -66,11 +67,24 @@ cv::Point upper_right_corner(const cv::Mat& labels, int label, bool* fallback) {
 }
 
 namespace {
+size_t quantile_index(size_t n, double q) {
+  return std::min(n - 1, size_t(std::floor(q * double(n - 1) + 0.5)));
+}
 double quantile(std::vector<double>& v, double q) {
   if (v.empty()) return std::numeric_limits<double>::quiet_NaN();
-  const size_t k = std::min(v.size() - 1, size_t(std::floor(q * double(v.size() - 1) + 0.5)));
+  const size_t k = quantile_index(v.size(), q);
   std::nth_element(v.begin(), v.begin() + long(k), v.end());
   return v[k];
+}
+/// quantile(v, q) and quantile(v, 1 - q) (q <= 0.5): the upper one is selected among the elements
+/// above the lower one only (an order statistic is one value whatever the selection did before).
+std::pair<double, double> quantile_pair(std::vector<double>& v, double q) {
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  if (v.empty()) return {nan, nan};
+  const size_t k0 = quantile_index(v.size(), q), k1 = quantile_index(v.size(), 1.0 - q);
+  std::nth_element(v.begin(), v.begin() + long(k0), v.end());
+  if (k1 > k0) std::nth_element(v.begin() + long(k0) + 1, v.begin() + long(k1), v.end());
+  return {v[k0], v[k1]};
 }
 std::string fmt(double v, int prec = 3) {
   std::ostringstream s;
@@ -123,23 +137,37 @@ std::vector<std::pair<int, int>> column_bands(const cv::Mat& labels, int label, 
 
 }  // namespace
 
-BookFrontResult select_book_front(const SegmentationResult& seg, const cv::Mat& points_camera,
-                                  const StereoGeometry& g, const Eigen::Isometry3d& camera_in_base,
-                                  const ShelfVolume& shelf, const SelectionParams& p) {
+BookFrontResult select_book_front(const SegmentationResult& seg, const cv::Mat& points_camera, const StereoGeometry& g,
+                                  const Eigen::Isometry3d& camera_in_base, const ShelfVolume& shelf,
+                                  const SelectionParams& p) {
   if (points_camera.type() != CV_32FC3 || points_camera.size() != seg.labels.size())
     throw std::invalid_argument("select_book_front: points must be CV_32FC3 of the label image's size");
   const size_t K = seg.regions.size();
   // Points of every region in the shelf-box frame.
   const Eigen::Isometry3d cam_in_box = shelf.box_in_base.inverse() * camera_in_base;
-  std::vector<std::vector<Eigen::Vector3f>> box_pts(K + 1);
+  // All regions' points in one array, region by region (first[lab] .. first[lab + 1]), raster order within.
+  std::vector<size_t> first(K + 2, 0);
+  const auto point_ok = [](const cv::Vec3f& q) {
+    return std::isfinite(q[0]) && std::isfinite(q[1]) && std::isfinite(q[2]);
+  };
   for (int y = 0; y < seg.labels.rows; ++y) {
     const int* l = seg.labels.ptr<int>(y);
     const cv::Vec3f* q = points_camera.ptr<cv::Vec3f>(y);
-    for (int x = 0; x < seg.labels.cols; ++x) {
-      const int lab = l[x];
-      if (lab <= 0 || size_t(lab) > K) continue;
-      if (!(std::isfinite(q[x][0]) && std::isfinite(q[x][1]) && std::isfinite(q[x][2]))) continue;
-      box_pts[size_t(lab)].push_back((cam_in_box * Eigen::Vector3d(q[x][0], q[x][1], q[x][2])).cast<float>());
+    for (int x = 0; x < seg.labels.cols; ++x)
+      if (l[x] > 0 && size_t(l[x]) <= K && point_ok(q[x])) ++first[size_t(l[x]) + 1];
+  }
+  for (size_t i = 1; i < first.size(); ++i) first[i] += first[i - 1];
+  std::vector<Eigen::Vector3f> box_pts(first[K + 1]);
+  {
+    std::vector<size_t> fill(first.begin(), first.end() - 1);
+    for (int y = 0; y < seg.labels.rows; ++y) {
+      const int* l = seg.labels.ptr<int>(y);
+      const cv::Vec3f* q = points_camera.ptr<cv::Vec3f>(y);
+      for (int x = 0; x < seg.labels.cols; ++x) {
+        const int lab = l[x];
+        if (lab <= 0 || size_t(lab) > K || !point_ok(q[x])) continue;
+        box_pts[fill[size_t(lab)]++] = (cam_in_box * Eigen::Vector3d(q[x][0], q[x][1], q[x][2])).cast<float>();
+      }
     }
   }
   const Eigen::Matrix3d R = camera_in_base.linear();
@@ -152,51 +180,59 @@ BookFrontResult select_book_front(const SegmentationResult& seg, const cv::Mat& 
   int best = 0;
   double best_y = std::numeric_limits<double>::infinity();
   // Depth along the rear-board normal (box x) of every pixel, for splitting wide regions.
-  cv::Mat rear_depth(seg.labels.size(), CV_32F, cv::Scalar(std::numeric_limits<float>::quiet_NaN()));
-  if (p.split_wide_fronts) {
+  // Computed when the first wide region needs it.
+  cv::Mat rear_depth;
+  const auto make_rear_depth = [&]() {
+    if (!rear_depth.empty()) return;
+    rear_depth.create(seg.labels.size(), CV_32F);
+    rear_depth.setTo(cv::Scalar(std::numeric_limits<float>::quiet_NaN()));
     for (int y = 0; y < seg.labels.rows; ++y) {
       const cv::Vec3f* q = points_camera.ptr<cv::Vec3f>(y);
       float* d = rear_depth.ptr<float>(y);
       for (int x = 0; x < seg.labels.cols; ++x)
         if (std::isfinite(q[x][2])) d[x] = float((cam_in_box * Eigen::Vector3d(q[x][0], q[x][1], q[x][2])).x());
     }
-  }
+  };
   std::vector<std::pair<int, int>> band_of(K + 1, {-1, -1});
+  std::vector<double> c[3], b1, b2;  // per region: base coordinates, box y and z of its points
   for (const PlaneRegion& r : seg.regions) {
     RegionVerdict v;
     v.label = r.label;
     v.normal_base = R * r.normal;
     v.offset_base = r.offset + v.normal_base.dot(camera_in_base.translation());
     v.centroid_base = camera_in_base * r.centroid;
-    auto& pts = box_pts[size_t(r.label)];
-    if (!pts.empty()) {
-      std::vector<double> c[3], b[3];
+    const Eigen::Vector3f* pts = box_pts.data() + first[size_t(r.label)];
+    const size_t num_pts = first[size_t(r.label) + 1] - first[size_t(r.label)];
+    if (num_pts > 0) {
+      for (int i = 0; i < 3; ++i) c[i].resize(num_pts);
+      b1.resize(num_pts);
+      b2.resize(num_pts);
       int inside = 0;
-      for (const auto& q : pts) {
+      for (size_t j = 0; j < num_pts; ++j) {
+        const Eigen::Vector3f& q = pts[j];
         const Eigen::Vector3d qb = shelf.box_in_base * q.cast<double>();
-        for (int i = 0; i < 3; ++i) {
-          c[i].push_back(qb(i));
-          b[i].push_back(q(i));
-        }
+        for (int i = 0; i < 3; ++i) c[i][j] = qb(i);
+        b1[j] = q(1);
+        b2[j] = q(2);
         if (std::fabs(q.x()) <= shelf.half_extent.x() && std::fabs(q.y()) <= shelf.half_extent.y() &&
             std::fabs(q.z()) <= shelf.half_extent.z())
           ++inside;
       }
-      v.inside_fraction = double(inside) / double(pts.size());
-      for (int i = 0; i < 3; ++i) {
-        v.extent_min_base(i) = quantile(c[i], p.extent_quantile);
-        v.extent_max_base(i) = quantile(c[i], 1.0 - p.extent_quantile);
-      }
-      v.width_m = quantile(b[1], 1.0 - p.extent_quantile) - quantile(b[1], p.extent_quantile);
-      v.height_m = quantile(b[2], 1.0 - p.extent_quantile) - quantile(b[2], p.extent_quantile);
+      v.inside_fraction = double(inside) / double(num_pts);
+      for (int i = 0; i < 3; ++i)
+        std::tie(v.extent_min_base(i), v.extent_max_base(i)) = quantile_pair(c[i], p.extent_quantile);
+      const auto [w0, w1] = quantile_pair(b1, p.extent_quantile);
+      const auto [h0, h1] = quantile_pair(b2, p.extent_quantile);
+      v.width_m = w1 - w0;
+      v.height_m = h1 - h0;
     }
     const double par = std::fabs(v.normal_base.dot(rear_n));
     const double perp = std::fabs(v.normal_base.dot(shelf_n));
     if (r.pixel_count < p.min_pixels) {
       v.reason = "too small: " + std::to_string(r.pixel_count) + " px < " + std::to_string(p.min_pixels);
     } else if (par < cos_par) {
-      v.reason = "not parallel to the rear board: " + fmt(std::acos(std::min(1.0, par)) * 180.0 / M_PI, 1) +
-                 " deg > " + fmt(p.parallel_tolerance_deg, 1);
+      v.reason = "not parallel to the rear board: " + fmt(std::acos(std::min(1.0, par)) * 180.0 / M_PI, 1) + " deg > " +
+                 fmt(p.parallel_tolerance_deg, 1);
     } else if (perp > sin_perp) {
       v.reason = "not perpendicular to the shelf: off by " + fmt(std::asin(std::min(1.0, perp)) * 180.0 / M_PI, 1) +
                  " deg > " + fmt(p.perpendicular_tolerance_deg, 1);
@@ -206,6 +242,7 @@ BookFrontResult select_book_front(const SegmentationResult& seg, const cv::Mat& 
     } else if (v.width_m > p.max_width_m && p.split_wide_fronts) {
       // Several coplanar fronts side by side: split into column bands, keep the right-most band that
       // looks like one book front.
+      make_rear_depth();
       const std::vector<std::pair<int, int>> bands = column_bands(seg.labels, r.label, r.bbox, rear_depth, p);
       double band_best_y = std::numeric_limits<double>::infinity();
       int passed = 0;
@@ -225,8 +262,9 @@ BookFrontResult select_book_front(const SegmentationResult& seg, const cv::Mat& 
           }
         }
         if (int(by.size()) < p.min_pixels) continue;
-        const double w = quantile(by, 1.0 - p.extent_quantile) - quantile(by, p.extent_quantile);
-        const double h = quantile(bz, 1.0 - p.extent_quantile) - quantile(bz, p.extent_quantile);
+        const auto [y0, y1] = quantile_pair(by, p.extent_quantile);
+        const auto [z0, z1] = quantile_pair(bz, p.extent_quantile);
+        const double w = y1 - y0, h = z1 - z0;
         if (w < p.min_width_m || w > p.max_width_m || h < p.min_height_m || h > p.max_height_m) continue;
         ++passed;
         const double cy = sum_y / double(by.size());
@@ -248,8 +286,7 @@ BookFrontResult select_book_front(const SegmentationResult& seg, const cv::Mat& 
     } else if (v.width_m < p.min_width_m || v.width_m > p.max_width_m) {
       v.reason = "width " + fmt(v.width_m) + " m not in [" + fmt(p.min_width_m) + ", " + fmt(p.max_width_m) + "]";
     } else if (v.height_m < p.min_height_m || v.height_m > p.max_height_m) {
-      v.reason =
-          "height " + fmt(v.height_m) + " m not in [" + fmt(p.min_height_m) + ", " + fmt(p.max_height_m) + "]";
+      v.reason = "height " + fmt(v.height_m) + " m not in [" + fmt(p.min_height_m) + ", " + fmt(p.max_height_m) + "]";
     } else {
       v.candidate = true;
       if (v.centroid_base.y() < best_y) {
