@@ -3,7 +3,8 @@
 # (the library task runs), kill the coordinator during a planned arm motion and check that the arm
 # driver stops (its heartbeats end) and the restarted coordinator resumes; then kill -9 each process
 # in turn and check that supervisord restarts it (a new pid reports on the bus), that the others keep
-# reporting, and that nobody rejects input because a neighbour restarted.
+# reporting, that nobody rejects input because a neighbour restarted, and (the simulation's truth, before
+# the simulation itself is killed last) that no book fell off while the others were killed.
 #   kill_restart_test.sh SOURCE_DIR BUILD_DIR
 set -euo pipefail
 SRC="$1"; BUILD="$2"
@@ -45,7 +46,29 @@ fi
 # that follow it would no longer test a neighbour's restart but a teleported world.
 order="$(grep -vx sim_world <<< "$(tr ' ' '\n' <<< "$names")" | paste -sd' ' -)"
 grep -qx sim_world <<< "$(tr ' ' '\n' <<< "$names")" && order="$order sim_world"
+# Where every book is, from the simulation's truth: "id:place ..." (places: upper_shelf, holder, lower_shelf,
+# gripper, other).
+book_places() {
+  local n fields=() i
+  n=$("$ECHO" --lcm-url "$BOOKGRASP_LCM_URL" --channel SIM_GROUND_TRUTH --count 1 --field num_books --timeout 10 \
+      | sed -n 's/.*num_books=\([0-9]*\).*/\1/p') || return 1
+  [ -n "$n" ] && [ "$n" -gt 0 ] || return 1
+  for i in $(seq 0 $((n - 1))); do fields+=(--field "books[$i].id" --field "books[$i].place"); done
+  "$ECHO" --lcm-url "$BOOKGRASP_LCM_URL" --channel SIM_GROUND_TRUTH --count 1 "${fields[@]}" --timeout 10 \
+    | grep -o 'books\[[0-9]*\]\.[a-z]*=[^ ]*' | sed 's/books\[[0-9]*\]\.id=//; s/books\[[0-9]*\]\.place=//' \
+    | paste -d: - - | tr -d '"' | paste -sd' ' -
+}
+places_before=$(book_places) || fail "no SIM_GROUND_TRUTH with books on the bus"
+echo "books before the kills: $places_before"
 for name in $order; do
+  if [ "$name" = sim_world ]; then
+    # Before the simulation itself restarts (which resets the world): no book was lost while every other
+    # process was killed and restarted: none fell off (place "other"), the count is the same.
+    places_after=$(book_places) || fail "no SIM_GROUND_TRUTH with books on the bus"
+    echo "books after killing every other process: $places_after"
+    [ "$(wc -w <<< "$places_after")" = "$(wc -w <<< "$places_before")" ] || fail "the number of books changed"
+    ! grep -q ':other' <<< "$places_after" || fail "a book was lost (place other): $places_after"
+  fi
   old=$(supervisorctl -c "$CONF" pid "$name")
   kill -9 "$old"
   new=$old
