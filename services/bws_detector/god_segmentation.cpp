@@ -76,6 +76,18 @@ struct Sums {
     yz += py * pz;
     zz += pz * pz;
   }
+  void add(const Sums& o) {
+    n += o.n;
+    x += o.x;
+    y += o.y;
+    z += o.z;
+    xx += o.xx;
+    xy += o.xy;
+    xz += o.xz;
+    yy += o.yy;
+    yz += o.yz;
+    zz += o.zz;
+  }
   PointMoments moments() const {
     PointMoments m;
     m.n = n;
@@ -403,31 +415,22 @@ SegmentationResult segment_god(const cv::Mat& image, const cv::Mat& points, cons
   };
 
   // Moments of every initial segment in merge space and in the output points' space (raster order,
-  // the same sums PointMoments::add would make).
-  std::vector<PointMoments> mom(size_t(count) + 1), omom;
-  {
-    std::vector<Sums> ms(size_t(count) + 1), os(same ? 0 : size_t(count) + 1);
-    for (int y = 0; y < H; ++y) {
-      const int* l = init.ptr<int>(y);
-      const float* v = image.ptr<float>(y);
-      const cv::Vec3f* q = points.empty() ? nullptr : points.ptr<cv::Vec3f>(y);
-      for (int x = 0; x < W; ++x) {
-        const int lab = l[x];
-        if (lab <= 0) continue;
-        if (image_space) {
-          if (valid_value(v[x])) ms[size_t(lab)].add(double(x), double(y), double(v[x]));
-        } else if (finite3(q[x])) {
-          ms[size_t(lab)].add(q[x][0], q[x][1], q[x][2]);
-        }
-        if (!same && finite3(q[x])) os[size_t(lab)].add(q[x][0], q[x][1], q[x][2]);
+  // the same sums PointMoments::add would make). When the two spaces are one, one array serves both.
+  std::vector<Sums> mom(size_t(count) + 1), omom_own(same ? 0 : size_t(count) + 1);
+  std::vector<Sums>& omom = same ? mom : omom_own;
+  for (int y = 0; y < H; ++y) {
+    const int* l = init.ptr<int>(y);
+    const float* v = image.ptr<float>(y);
+    const cv::Vec3f* q = points.empty() ? nullptr : points.ptr<cv::Vec3f>(y);
+    for (int x = 0; x < W; ++x) {
+      const int lab = l[x];
+      if (lab <= 0) continue;
+      if (image_space) {
+        if (valid_value(v[x])) mom[size_t(lab)].add(double(x), double(y), double(v[x]));
+      } else if (finite3(q[x])) {
+        mom[size_t(lab)].add(q[x][0], q[x][1], q[x][2]);
       }
-    }
-    for (int i = 1; i <= count; ++i) mom[size_t(i)] = ms[size_t(i)].moments();
-    if (same) {
-      omom = mom;
-    } else {
-      omom.resize(size_t(count) + 1);
-      for (int i = 1; i <= count; ++i) omom[size_t(i)] = os[size_t(i)].moments();
+      if (!same && finite3(q[x])) omom[size_t(lab)].add(q[x][0], q[x][1], q[x][2]);
     }
   }
 
@@ -496,14 +499,15 @@ SegmentationResult segment_god(const cv::Mat& image, const cv::Mat& points, cons
   std::vector<uint8_t> fitted(size_t(count) + 1, 0);  // bit 0: planes[i] current, bit 1: oplanes[i] current
   const auto plane = [&](int i) -> const Plane& {
     if (!(fitted[size_t(i)] & 1)) {
-      planes[size_t(i)] = fit_plane(mom[size_t(i)]);
+      planes[size_t(i)] = fit_plane(mom[size_t(i)].moments());
       fitted[size_t(i)] |= 1;
     }
     return planes[size_t(i)];
   };
   const auto oplane = [&](int i) -> const Plane& {
+    if (same) return plane(i);
     if (!(fitted[size_t(i)] & 2)) {
-      oplanes[size_t(i)] = fit_plane(omom[size_t(i)]);
+      oplanes[size_t(i)] = fit_plane(omom[size_t(i)].moments());
       fitted[size_t(i)] |= 2;
     }
     return oplanes[size_t(i)];
@@ -534,7 +538,7 @@ SegmentationResult segment_god(const cv::Mat& image, const cv::Mat& points, cons
       const bool a_large = mom[size_t(a)].n >= mom[size_t(b)].n;
       const int L = a_large ? a : b, S = a_large ? b : a;
       if (mom[size_t(S)].n <= 0.0 || !plane(L).valid) return -1.0;
-      const double d = rms_distance(mom[size_t(S)], plane(L));
+      const double d = rms_distance(mom[size_t(S)].moments(), plane(L));
       if (!(d < T)) return -1.0;
       if (omom[size_t(a)].n >= gate_n && omom[size_t(b)].n >= gate_n && oplane(a).valid && oplane(b).valid &&
           std::fabs(oplane(a).normal.dot(oplane(b).normal)) < cos_gate)
@@ -559,7 +563,7 @@ SegmentationResult segment_god(const cv::Mat& image, const cv::Mat& points, cons
       const int root = uf.unite(a, b);
       const int other = root == a ? b : a;
       mom[size_t(root)].add(mom[size_t(other)]);
-      omom[size_t(root)].add(omom[size_t(other)]);
+      if (!same) omom[size_t(root)].add(omom[size_t(other)]);
       fitted[size_t(root)] = 0;
       touched[size_t(root)] = 1;
       ++dbg.merges;
@@ -572,7 +576,8 @@ SegmentationResult segment_god(const cv::Mat& image, const cv::Mat& points, cons
   // Merged labels, numbered 1..K in raster order of their first pixel. A root is the smallest initial
   // label of its set, i.e. the set's first initial segment in raster order, so this numbering keeps the
   // order of the roots (the growth's tie-break) and describe_regions gets K instead of `count` slots.
-  cv::Mat labels(image.size(), CV_32S);
+  // Without debug output the initial labels are relabelled in place (reads precede writes per pixel).
+  cv::Mat labels = debug ? cv::Mat(image.size(), CV_32S) : dbg.initial_labels;
   std::vector<int> id_of_initial(size_t(count) + 1, 0), id_of_root(size_t(count) + 1, 0);
   std::vector<int> root_of_id(1, 0);
   for (int y = 0; y < H; ++y) {
@@ -655,7 +660,7 @@ SegmentationResult segment_god(const cv::Mat& image, const cv::Mat& points, cons
     }
   }
 
-  return describe_regions(labels, points.empty() ? image_space_points(image) : points, params.min_region_px);
+  return describe_regions_in_place(labels, points.empty() ? image_space_points(image) : points, params.min_region_px);
 }
 
 }  // namespace bookgrasp::bws

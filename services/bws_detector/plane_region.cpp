@@ -48,7 +48,9 @@ cv::Mat image_space_points(const cv::Mat& image) {
   return pts;
 }
 
-SegmentationResult describe_regions(const cv::Mat& labels, const cv::Mat& points, int min_pixels) {
+namespace {
+
+SegmentationResult describe(const cv::Mat& labels, const cv::Mat& points, int min_pixels, bool in_place) {
   if (labels.type() != CV_32S) throw std::invalid_argument("describe_regions: labels must be CV_32S");
   if (points.type() != CV_32FC3 || points.size() != labels.size())
     throw std::invalid_argument("describe_regions: points must be CV_32FC3 of the labels' size");
@@ -58,10 +60,11 @@ SegmentationResult describe_regions(const cv::Mat& labels, const cv::Mat& points
     const int* l = labels.ptr<int>(y);
     for (int x = 0; x < labels.cols; ++x) max_label = std::max(max_label, l[x]);
   }
+  // Moment sums as PointMoments::add makes them (same products, same order), the six distinct products.
   struct Acc {
     int pixels = 0;
     int x0 = std::numeric_limits<int>::max(), y0 = std::numeric_limits<int>::max(), x1 = -1, y1 = -1;
-    PointMoments m;
+    double n = 0.0, sx = 0.0, sy = 0.0, sz = 0.0, xx = 0.0, xy = 0.0, xz = 0.0, yy = 0.0, yz = 0.0, zz = 0.0;
     Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
     Eigen::Vector3d hi = Eigen::Vector3d::Constant(-std::numeric_limits<double>::infinity());
     int first = -1;
@@ -83,7 +86,16 @@ SegmentationResult describe_regions(const cv::Mat& labels, const cv::Mat& points
       const cv::Vec3f& q = p[x];
       if (std::isfinite(q[0]) && std::isfinite(q[1]) && std::isfinite(q[2])) {
         const Eigen::Vector3d v(q[0], q[1], q[2]);
-        a.m.add(v);
+        a.n += 1.0;
+        a.sx += v[0];
+        a.sy += v[1];
+        a.sz += v[2];
+        a.xx += v[0] * v[0];
+        a.xy += v[0] * v[1];
+        a.xz += v[0] * v[2];
+        a.yy += v[1] * v[1];
+        a.yz += v[1] * v[2];
+        a.zz += v[2] * v[2];
         a.lo = a.lo.cwiseMin(v);
         a.hi = a.hi.cwiseMax(v);
       }
@@ -99,29 +111,43 @@ SegmentationResult describe_regions(const cv::Mat& labels, const cv::Mat& points
   for (int lab : order) {
     const Acc& a = acc[size_t(lab)];
     if (a.pixels < min_pixels) continue;
-    const Plane plane = fit_plane(a.m);
+    PointMoments m;
+    m.n = a.n;
+    m.sum = Eigen::Vector3d(a.sx, a.sy, a.sz);
+    m.sum_outer << a.xx, a.xy, a.xz, a.xy, a.yy, a.yz, a.xz, a.yz, a.zz;
+    const Plane plane = fit_plane(m);
     if (!plane.valid) continue;
     PlaneRegion r;
     r.label = int(out.regions.size()) + 1;
     r.pixel_count = a.pixels;
-    r.point_count = int(a.m.n);
+    r.point_count = int(m.n);
     r.bbox = cv::Rect(a.x0, a.y0, a.x1 - a.x0 + 1, a.y1 - a.y0 + 1);
     r.normal = plane.normal;
     r.offset = plane.offset;
-    r.centroid = a.m.sum / a.m.n;
-    r.rms_residual = rms_distance(a.m, plane);
+    r.centroid = m.sum / m.n;
+    r.rms_residual = rms_distance(m, plane);
     r.extent_min = a.lo;
     r.extent_max = a.hi;
     remap[size_t(lab)] = r.label;
     out.regions.push_back(r);
   }
-  out.labels = cv::Mat(labels.size(), CV_32S);
+  out.labels = in_place ? labels : cv::Mat(labels.size(), CV_32S);
   for (int y = 0; y < labels.rows; ++y) {
     const int* l = labels.ptr<int>(y);
     int* o = out.labels.ptr<int>(y);
     for (int x = 0; x < labels.cols; ++x) o[x] = l[x] > 0 ? remap[size_t(l[x])] : 0;
   }
   return out;
+}
+
+}  // namespace
+
+SegmentationResult describe_regions(const cv::Mat& labels, const cv::Mat& points, int min_pixels) {
+  return describe(labels, points, min_pixels, false);
+}
+
+SegmentationResult describe_regions_in_place(cv::Mat& labels, const cv::Mat& points, int min_pixels) {
+  return describe(labels, points, min_pixels, true);
 }
 
 }  // namespace bookgrasp::bws

@@ -95,6 +95,10 @@ double rms_distance(const PointMoments& m, const Plane& plane);
 /// become 0. Returns the renumbered label image and the descriptions.
 SegmentationResult describe_regions(const cv::Mat& labels, const cv::Mat& points, int min_pixels);
 
+/// describe_regions() that renumbers `labels` in place: the result's label image is `labels`' buffer
+/// (saves allocating and touching another label image).
+SegmentationResult describe_regions_in_place(cv::Mat& labels, const cv::Mat& points, int min_pixels);
+
 /// A CV_32FC3 image of (x, y, value) for every pixel of a CV_32F image
 /// (non-finite or <= 0 values give NaN points). In this space a 3D plane seen
 /// in a disparity image is a plane (disparity is affine in x, y on a plane).

@@ -1,13 +1,17 @@
 // Tests of the GoD planar segmentation on synthetic images whose planes are known analytically.
 #include "services/bws_detector/god_segmentation.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <map>
 #include <set>
+#include <tuple>
+#include <vector>
 
 #include <gtest/gtest.h>
 
+#include "services/bws_detector/disparity.h"
 #include "services/eval_segmentation/hoover_comparison.h"
 #include "synthetic_shelf.h"
 
@@ -52,8 +56,8 @@ GodParams test_params() {
 
 TEST(GodFeatures, DgodOfKnownPlanesMatchesAtan2) {
   // Gradients in every octant, on the axes and off them.
-  const double grads[][2] = {{0.1, 0.0},  {0.1, 0.1},   {0.0, 0.1},   {-0.1, 0.1}, {-0.1, 0.0}, {-0.1, -0.1},
-                             {0.0, -0.1}, {0.1, -0.1},  {0.03, 0.07}, {-0.2, 0.05}, {0.2, -0.011}, {0.001, 0.3}};
+  const double grads[][2] = {{0.1, 0.0},  {0.1, 0.1},  {0.0, 0.1},   {-0.1, 0.1},  {-0.1, 0.0},   {-0.1, -0.1},
+                             {0.0, -0.1}, {0.1, -0.1}, {0.03, 0.07}, {-0.2, 0.05}, {0.2, -0.011}, {0.001, 0.3}};
   for (const auto& g : grads) {
     const cv::Mat img = affine_image(20, 15, g[0], g[1], 50.0);
     const GodFeatures f = compute_god_features(img, 1, 0.0);
@@ -156,7 +160,8 @@ TEST(VoteClusters, RemovesIsolatedNoise) {
 TEST(SegmentGod, CreaseGivesTwoRegionsWithExactPlanes) {
   cv::Mat img(60, 80, CV_32F);
   for (int y = 0; y < 60; ++y)
-    for (int x = 0; x < 80; ++x) img.at<float>(y, x) = float(x < 40 ? 20.0 + 0.2 * x + 0.05 * y : 36.2 - 0.2 * x + 0.05 * y);
+    for (int x = 0; x < 80; ++x)
+      img.at<float>(y, x) = float(x < 40 ? 20.0 + 0.2 * x + 0.05 * y : 36.2 - 0.2 * x + 0.05 * y);
   const SegmentationResult r = segment_god(img, cv::Mat(), test_params());
   ASSERT_EQ(r.regions.size(), 2u);
   for (const PlaneRegion& reg : r.regions) {
@@ -202,7 +207,7 @@ TEST(SegmentGod, MergingJoinsFragmentsOfOnePlaneButNotParallelPlanes) {
     for (int x = 0; x < 100; ++x)
       img.at<float>(y, x) = float(40.0 + 0.02 * x + 0.01 * y + (x >= 60 ? 1.0 : 0.0) + rng.gaussian(0.01));
   GodParams p = test_params();
-  p.window_size = 3;   // little smoothing of directions: many initial fragments
+  p.window_size = 3;  // little smoothing of directions: many initial fragments
   p.jump_mgod_min = 0.6;
   p.merge_distance = 0.75;
   GodDebug dbg;
@@ -243,6 +248,172 @@ TEST(SegmentGod, BadInputIsRejectedWithAMessage) {
   EXPECT_TRUE(r.regions.empty());
 }
 
+// A straightforward GoD (brute-force n x n votes, flood-fill components, pixel-pair adjacency, moments
+// with PointMoments::add, the documented merge rule, growth by full scans): the optimised segment_god
+// must give exactly the same labels and regions (same arithmetic, so bit for bit).
+SegmentationResult reference_god(const cv::Mat& img, const cv::Mat& points, const GodParams& p) {
+  const int W = img.cols, H = img.rows, B = p.direction_bins;
+  const cv::Mat bins = god_bins(compute_god_features(img, p.gradient_step, p.flat_mgod_max), B, p.jump_mgod_min);
+  cv::Mat cls(img.size(), CV_8U, cv::Scalar(255));
+  const int r = p.window_size / 2;
+  for (int y = 0; y < H; ++y)
+    for (int x = 0; x < W; ++x) {
+      if (bins.at<uint8_t>(y, x) == 255) continue;
+      std::vector<int> votes(size_t(B) + 1, 0);
+      for (int yy = std::max(0, y - r); yy <= std::min(H - 1, y + r); ++yy)
+        for (int xx = std::max(0, x - r); xx <= std::min(W - 1, x + r); ++xx)
+          if (bins.at<uint8_t>(yy, xx) != 255) ++votes[bins.at<uint8_t>(yy, xx)];
+      cls.at<uint8_t>(y, x) = uint8_t(std::max_element(votes.begin(), votes.end()) - votes.begin());
+    }
+  cv::Mat lab(img.size(), CV_32S, cv::Scalar(0));
+  int count = 0;
+  for (int y = 0; y < H; ++y)
+    for (int x = 0; x < W; ++x) {
+      if (cls.at<uint8_t>(y, x) == 255 || lab.at<int>(y, x)) continue;
+      lab.at<int>(y, x) = ++count;
+      std::vector<cv::Point> stack{{x, y}};
+      while (!stack.empty()) {
+        const cv::Point q = stack.back();
+        stack.pop_back();
+        for (const cv::Point d : {cv::Point(1, 0), cv::Point(-1, 0), cv::Point(0, 1), cv::Point(0, -1)}) {
+          const cv::Point n = q + d;
+          if (n.x < 0 || n.y < 0 || n.x >= W || n.y >= H || lab.at<int>(n) || cls.at<uint8_t>(n) != cls.at<uint8_t>(q))
+            continue;
+          lab.at<int>(n) = count;
+          stack.push_back(n);
+        }
+      }
+    }
+  const cv::Mat mp = p.merge_space == MergeSpace::kImage ? image_space_points(img) : points;
+  const cv::Mat op = points.empty() ? mp : points;
+  std::vector<PointMoments> mom(size_t(count) + 1), omom(size_t(count) + 1);
+  const auto ok = [](const cv::Vec3f& v) { return std::isfinite(v[0]) && std::isfinite(v[1]) && std::isfinite(v[2]); };
+  std::set<std::pair<int, int>> adj;
+  const int R = p.adjacency_radius_px;
+  for (int y = 0; y < H; ++y)
+    for (int x = 0; x < W; ++x) {
+      const int a = lab.at<int>(y, x);
+      if (a == 0) continue;
+      const cv::Vec3f m = mp.at<cv::Vec3f>(y, x), o = op.at<cv::Vec3f>(y, x);
+      if (ok(m)) mom[size_t(a)].add(Eigen::Vector3d(m[0], m[1], m[2]));
+      if (ok(o)) omom[size_t(a)].add(Eigen::Vector3d(o[0], o[1], o[2]));
+      for (int yy = std::max(0, y - R); yy <= std::min(H - 1, y + R); ++yy)
+        for (int xx = std::max(0, x - R); xx <= std::min(W - 1, x + R); ++xx) {
+          const int b = lab.at<int>(yy, xx);
+          if (b != 0 && b != a) adj.insert({std::min(a, b), std::max(a, b)});
+        }
+    }
+  std::vector<int> parent(size_t(count) + 1);
+  for (int i = 0; i <= count; ++i) parent[size_t(i)] = i;
+  const auto find = [&](int a) {
+    while (parent[size_t(a)] != a) a = parent[size_t(a)];
+    return a;
+  };
+  const double cos_gate = std::cos(p.merge_max_angle_deg * M_PI / 180.0);
+  const auto cost = [&](int a, int b) {
+    const int L = mom[size_t(a)].n >= mom[size_t(b)].n ? a : b, S = L == a ? b : a;
+    const Plane pl = fit_plane(mom[size_t(L)]);
+    if (mom[size_t(S)].n <= 0.0 || !pl.valid) return -1.0;
+    const double d = rms_distance(mom[size_t(S)], pl);
+    if (!(d < p.merge_distance)) return -1.0;
+    const Plane pa = fit_plane(omom[size_t(a)]), pb = fit_plane(omom[size_t(b)]);
+    const double gate = p.merge_angle_min_px;
+    if (omom[size_t(a)].n >= gate && omom[size_t(b)].n >= gate && pa.valid && pb.valid &&
+        std::fabs(pa.normal.dot(pb.normal)) < cos_gate)
+      return -1.0;
+    return d;
+  };
+  for (bool merged = true; merged;) {
+    std::set<std::pair<int, int>> roots;
+    for (const auto& [a, b] : adj)
+      if (find(a) != find(b)) roots.insert({std::min(find(a), find(b)), std::max(find(a), find(b))});
+    adj = roots;
+    std::vector<std::tuple<double, int, int>> cand;
+    for (const auto& [a, b] : adj)
+      if (cost(a, b) >= 0.0) cand.emplace_back(cost(a, b), a, b);
+    std::sort(cand.begin(), cand.end());
+    std::set<int> touched;
+    merged = false;
+    for (const auto& [d, a0, b0] : cand) {
+      const int a = find(a0), b = find(b0);
+      if (a == b) continue;
+      if ((a != a0 || b != b0 || touched.count(a) || touched.count(b)) && cost(a, b) < 0.0) continue;
+      const int root = std::min(a, b), other = std::max(a, b);
+      parent[size_t(other)] = root;
+      mom[size_t(root)].add(mom[size_t(other)]);
+      omom[size_t(root)].add(omom[size_t(other)]);
+      touched.insert(root);
+      merged = true;
+    }
+  }
+  for (int y = 0; y < H; ++y)
+    for (int x = 0; x < W; ++x)
+      if (lab.at<int>(y, x)) lab.at<int>(y, x) = find(lab.at<int>(y, x));
+  for (int g = 0; g < p.boundary_growth_px; ++g) {
+    cv::Mat next = lab.clone();
+    for (int y = 0; y < H; ++y)
+      for (int x = 0; x < W; ++x) {
+        const cv::Vec3f m = mp.at<cv::Vec3f>(y, x);
+        if (lab.at<int>(y, x) || !ok(m)) continue;
+        int best = 0;
+        double best_d = p.boundary_growth_distance;
+        for (int yy = std::max(0, y - 1); yy <= std::min(H - 1, y + 1); ++yy)
+          for (int xx = std::max(0, x - 1); xx <= std::min(W - 1, x + 1); ++xx) {
+            const int b = lab.at<int>(yy, xx);
+            const Plane pl = b ? fit_plane(mom[size_t(b)]) : Plane();
+            if (!pl.valid) continue;
+            const double d = std::fabs(pl.normal.dot(Eigen::Vector3d(m[0], m[1], m[2])) - pl.offset);
+            if (d < best_d || (d == best_d && best != 0 && b < best)) std::tie(best_d, best) = std::make_tuple(d, b);
+          }
+        next.at<int>(y, x) = best;
+      }
+    lab = next;
+  }
+  return describe_regions(lab, op, p.min_region_px);
+}
+
+void expect_same(const SegmentationResult& a, const SegmentationResult& b, const std::string& what) {
+  EXPECT_EQ(cv::countNonZero(a.labels != b.labels), 0) << what;
+  ASSERT_EQ(a.regions.size(), b.regions.size()) << what;
+  for (size_t i = 0; i < a.regions.size(); ++i) {
+    const PlaneRegion &u = a.regions[i], &v = b.regions[i];
+    EXPECT_TRUE(u.pixel_count == v.pixel_count && u.point_count == v.point_count && u.bbox == v.bbox &&
+                u.normal == v.normal && u.offset == v.offset && u.centroid == v.centroid &&
+                u.rms_residual == v.rms_residual && u.extent_min == v.extent_min && u.extent_max == v.extent_max)
+        << what << ": region " << i + 1;
+  }
+}
+
+// The optimised segmentation against the reference on StereoBM disparity of the shelf (noisy: thousands
+// of initial segments, many merges), in image and in point merge space, with and without debug output.
+TEST(SegmentGod, EqualsAStraightforwardReferenceBitForBit) {
+  const test::ShelfScene scene = test::make_shelf_scene(1);
+  DisparityParams dp;
+  dp.block_size = 7;
+  const cv::Mat disp = compute_disparity(test::render_boxes(scene.boxes, scene.left, true).intensity,
+                                         test::render_boxes(scene.boxes, scene.right, true).intensity, dp);
+  const StereoGeometry g{scene.left.fx, scene.left.fy, scene.left.cx, scene.left.cy, scene.baseline_m};
+  const cv::Mat roi(disp, cv::Rect(160, 120, 320, 240));  // the books and the boards around them
+  const cv::Mat d = roi.clone(), pts = disparity_to_points(d, g);
+  GodParams p = test_params();
+  p.jump_mgod_min = 0.6;
+  p.merge_distance = 0.75;
+  p.min_region_px = 30;
+  GodDebug dbg;
+  const SegmentationResult fast = segment_god(d, pts, p, &dbg);
+  EXPECT_GT(dbg.initial_count, 300);
+  EXPECT_GT(dbg.merges, 100);
+  expect_same(fast, reference_god(d, pts, p), "image space");
+  expect_same(segment_god(d, pts, p), fast, "without debug output");
+  p.adjacency_radius_px = 1;
+  p.window_size = 3;
+  p.boundary_growth_px = 3;
+  expect_same(segment_god(d, cv::Mat(), p), reference_god(d, cv::Mat(), p), "no points, R = 1");
+  p.merge_space = MergeSpace::kPoints;
+  p.merge_distance = 0.01;
+  expect_same(segment_god(d, pts, p), reference_god(d, pts, p), "point space");
+}
+
 // The synthetic shelf (exact disparity): GoD's segments against the rendered face ids (Hoover).
 TEST(SegmentGod, ShelfSceneSegmentsAgainstGroundTruthFaces) {
   const test::ShelfScene scene = test::make_shelf_scene(11);
@@ -265,8 +436,9 @@ TEST(SegmentGod, ShelfSceneSegmentsAgainstGroundTruthFaces) {
     for (int x = 0; x < gt.cols; ++x)
       if (size[gt.at<int>(y, x)] < 200) gt.at<int>(y, x) = 0;
   const eval_segmentation::HooverResult s = eval_segmentation::hoover_compare(gt, r.labels, 0.8);
-  std::printf("GoD on exact shelf disparity, T=0.8: %d GT regions, correct %d, over %d, under %d, missed %d, noise %d\n",
-              s.num_gt(), s.correct, s.over, s.under, s.missed, s.noise);
+  std::printf(
+      "GoD on exact shelf disparity, T=0.8: %d GT regions, correct %d, over %d, under %d, missed %d, noise %d\n",
+      s.num_gt(), s.correct, s.over, s.under, s.missed, s.noise);
   EXPECT_GE(double(s.correct) / s.num_gt(), 0.6);
   // Every book front (face -x of every book box) is a correct detection on its own at T = 0.8.
   for (int b = scene.first_book; b < scene.first_book + scene.num_books; ++b) {
