@@ -9,6 +9,8 @@
 #include <tuple>
 #include <vector>
 
+#include <Eigen/Eigenvalues>
+
 #include "common/config.h"
 
 #if defined(__SSE2__)
@@ -41,7 +43,13 @@ inline bool valid_value(float v) {
 
 struct UnionFind {
   std::vector<int> parent;
-  explicit UnionFind(size_t n) : parent(n) { std::iota(parent.begin(), parent.end(), 0); }
+  UnionFind() = default;
+  explicit UnionFind(size_t n) { reset(n); }
+  /// Singletons 0..n-1 (keeps the vector's capacity).
+  void reset(size_t n) {
+    parent.resize(n);
+    std::iota(parent.begin(), parent.end(), 0);
+  }
   int find(int a) {
     while (parent[size_t(a)] != a) {
       parent[size_t(a)] = parent[size_t(parent[size_t(a)])];
@@ -97,6 +105,33 @@ struct Sums {
   }
 };
 
+/// The merge's plane of a segment: fit_plane(s.moments()) with the covariance's eigenvectors from
+/// Eigen's closed-form 3x3 solver (analytic eigenvalues, eigenvectors from cross products of rows)
+/// instead of its iterative one: ~5x cheaper; the normal can differ from fit_plane's in the last bits.
+/// Near-degenerate sets (second eigenvalue near the degeneracy threshold) and ill-conditioned ones
+/// (two smallest eigenvalues close, where the closed form loses accuracy) use fit_plane itself.
+/// Only the merge and growth use it; the output regions are described with fit_plane.
+Plane fit_plane_closed_form(const Sums& s) {
+  Plane plane;
+  if (s.n < 3.0) return plane;
+  const Eigen::Vector3d mean = Eigen::Vector3d(s.x, s.y, s.z) / s.n;
+  Eigen::Matrix3d so;
+  so << s.xx, s.xy, s.xz, s.xy, s.yy, s.yz, s.xz, s.yz, s.zz;
+  const Eigen::Matrix3d cov = so / s.n - mean * mean.transpose();
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver;
+  solver.computeDirect(cov);
+  const Eigen::Vector3d ev = solver.eigenvalues();
+  const double scale = std::max(1.0, ev(2));
+  if (!ev.allFinite() || !(ev(1) > 1e-9 * scale) || !(ev(1) - ev(0) > 1e-6 * ev(2))) return fit_plane(s.moments());
+  Eigen::Vector3d n = solver.eigenvectors().col(0).normalized();
+  if (!n.allFinite()) return fit_plane(s.moments());
+  if (n.dot(mean) > 0.0) n = -n;
+  plane.normal = n;
+  plane.offset = n.dot(mean);
+  plane.valid = true;
+  return plane;
+}
+
 inline bool finite3(const cv::Vec3f& q) {
   return std::isfinite(q[0]) && std::isfinite(q[1]) && std::isfinite(q[2]);
 }
@@ -123,15 +158,65 @@ void unique_edges(std::vector<uint64_t>& edges, int count, std::vector<uint64_t>
 
 /// god_bins(compute_god_features(image, s, flat), B, jump) without the two float images (same arithmetic,
 /// and no arctangent for jump pixels, which do not vote).
-cv::Mat god_bins_of_image(const cv::Mat& image, int s, double flat_mgod_max, int B, double jump_mgod_min) {
-  cv::Mat bins(image.size(), CV_8U, cv::Scalar(255));
+void god_bins_of_image(const cv::Mat& image, int s, double flat_mgod_max, int B, double jump_mgod_min, cv::Mat& bins) {
+  bins.create(image.size(), CV_8U);
+  bins.setTo(cv::Scalar(255));
   const float flat = float(flat_mgod_max), jump = float(jump_mgod_min), w = 360.f / float(B);
   for (int y = s; y < image.rows - s; ++y) {
     const float* up = image.ptr<float>(y - s);
     const float* mid = image.ptr<float>(y);
     const float* dn = image.ptr<float>(y + s);
     uint8_t* b = bins.ptr<uint8_t>(y);
-    for (int x = s; x < image.cols - s; ++x) {
+    int x = s;
+#if defined(__SSE2__)
+    // Four pixels at a time, the scalar loop's operations in the same order (IEEE single precision
+    // either way, no fused multiply-add on this target), branches as masks.
+    const __m128 zero = _mm_setzero_ps(), inf = _mm_set1_ps(std::numeric_limits<float>::infinity());
+    const __m128 vflat = _mm_set1_ps(flat), vjump = _mm_set1_ps(jump), vw = _mm_set1_ps(w);
+    const __m128 sign = _mm_set1_ps(-0.f), half = _mm_set1_ps(0.5f);
+    const __m128i vB = _mm_set1_epi32(B), vBm1 = _mm_set1_epi32(B - 1);
+    const auto valid4 = [&](__m128 v) { return _mm_and_ps(_mm_cmpgt_ps(v, zero), _mm_cmplt_ps(v, inf)); };
+    for (; x + 4 <= image.cols - s; x += 4) {
+      const __m128 c = _mm_loadu_ps(mid + x), r = _mm_loadu_ps(mid + x + s), l = _mm_loadu_ps(mid + x - s);
+      const __m128 d = _mm_loadu_ps(dn + x), u = _mm_loadu_ps(up + x);
+      const __m128 ok =
+          _mm_and_ps(_mm_and_ps(_mm_and_ps(valid4(c), valid4(r)), _mm_and_ps(valid4(l), valid4(d))), valid4(u));
+      const __m128 dx = _mm_sub_ps(r, l), dy = _mm_sub_ps(d, u);
+      const __m128 m = _mm_sqrt_ps(_mm_add_ps(_mm_mul_ps(dx, dx), _mm_mul_ps(dy, dy)));
+      const __m128 votes = _mm_and_ps(ok, _mm_cmple_ps(m, vjump));
+      const int vmask = _mm_movemask_ps(votes);
+      if (vmask == 0) continue;
+      const __m128 is_flat = _mm_cmple_ps(m, vflat);
+      // direction_deg
+      const __m128 ax = _mm_andnot_ps(sign, dx), ay = _mm_andnot_ps(sign, dy);
+      const __m128 ay_gt = _mm_cmpgt_ps(ay, ax);
+      const __m128 mn = _mm_or_ps(_mm_and_ps(_mm_cmplt_ps(ay, ax), ay), _mm_andnot_ps(_mm_cmplt_ps(ay, ax), ax));
+      const __m128 mx = _mm_or_ps(_mm_and_ps(_mm_cmplt_ps(ax, ay), ay), _mm_andnot_ps(_mm_cmplt_ps(ax, ay), ax));
+      const __m128 t = _mm_div_ps(mn, mx);
+      const __m128 s2 = _mm_mul_ps(t, t);
+      __m128 p = _mm_mul_ps(s2, _mm_set1_ps(0.0208351f));
+      p = _mm_mul_ps(s2, _mm_add_ps(_mm_set1_ps(-0.0851330f), p));
+      p = _mm_mul_ps(s2, _mm_add_ps(_mm_set1_ps(0.1801410f), p));
+      p = _mm_mul_ps(s2, _mm_add_ps(_mm_set1_ps(-0.3302995f), p));
+      __m128 a = _mm_mul_ps(t, _mm_add_ps(_mm_set1_ps(0.9998660f), p));
+      a = _mm_mul_ps(a, _mm_set1_ps(57.295779513f));
+      const auto pick = [](__m128 mask, __m128 yes, __m128 no) {
+        return _mm_or_ps(_mm_and_ps(mask, yes), _mm_andnot_ps(mask, no));
+      };
+      a = pick(ay_gt, _mm_sub_ps(_mm_set1_ps(90.f), a), a);
+      a = pick(_mm_cmplt_ps(dx, zero), _mm_sub_ps(_mm_set1_ps(180.f), a), a);
+      a = pick(_mm_cmplt_ps(dy, zero), _mm_xor_ps(a, sign), a);
+      a = pick(_mm_cmple_ps(a, zero), _mm_add_ps(a, _mm_set1_ps(360.f)), a);
+      __m128i k = _mm_cvttps_epi32(_mm_add_ps(_mm_div_ps(a, vw), half));
+      k = _mm_sub_epi32(k, _mm_and_si128(_mm_cmpgt_epi32(k, vBm1), vB));  // k >= B: k -= B
+      k = _mm_or_si128(_mm_and_si128(_mm_castps_si128(is_flat), vB), _mm_andnot_si128(_mm_castps_si128(is_flat), k));
+      alignas(16) int32_t kk[4];
+      _mm_store_si128(reinterpret_cast<__m128i*>(kk), k);
+      for (int i = 0; i < 4; ++i)
+        if (vmask & (1 << i)) b[x + i] = uint8_t(kk[i]);
+    }
+#endif
+    for (; x < image.cols - s; ++x) {
       const float r = mid[x + s], l = mid[x - s], d = dn[x], u = up[x];
       if (!(valid_value(mid[x]) && valid_value(r) && valid_value(l) && valid_value(d) && valid_value(u))) continue;
       const float dx = r - l, dy = d - u;
@@ -146,7 +231,6 @@ cv::Mat god_bins_of_image(const cv::Mat& image, int s, double flat_mgod_max, int
       }
     }
   }
-  return bins;
 }
 
 }  // namespace
@@ -242,8 +326,10 @@ cv::Mat god_bins(const GodFeatures& f, int B, double jump_mgod_min) {
 
 namespace {
 
-/// Histogram lanes are counted in 16 bits (n * n <= 101 * 101 votes), padded to whole vectors of 8.
+/// Histogram lanes are counted in 16 bits (n * n <= 101 * 101 votes), padded to whole vectors of 8, or
+/// in 8 bits (windows up to 15 x 15: n * n <= 225 votes), padded to whole vectors of 16.
 using Count = uint16_t;
+using Count8 = uint8_t;
 
 #if defined(__SSE2__)
 inline void hist_add(Count* h, const Count* c, int K) {
@@ -275,14 +361,46 @@ inline int hist_argmax(const Count* h, int K) {
   }
   return 0;
 }
+inline void hist_add(Count8* h, const Count8* c, int K) {
+  for (int k = 0; k < K; k += 16) {
+    const __m128i a = _mm_loadu_si128(reinterpret_cast<const __m128i*>(h + k));
+    _mm_storeu_si128(reinterpret_cast<__m128i*>(h + k),
+                     _mm_add_epi8(a, _mm_loadu_si128(reinterpret_cast<const __m128i*>(c + k))));
+  }
+}
+inline void hist_sub(Count8* h, const Count8* c, int K) {
+  for (int k = 0; k < K; k += 16) {
+    const __m128i a = _mm_loadu_si128(reinterpret_cast<const __m128i*>(h + k));
+    _mm_storeu_si128(reinterpret_cast<__m128i*>(h + k),
+                     _mm_sub_epi8(a, _mm_loadu_si128(reinterpret_cast<const __m128i*>(c + k))));
+  }
+}
+/// As above for 8-bit counts (unsigned max).
+inline int hist_argmax(const Count8* h, int K) {
+  __m128i mx = _mm_loadu_si128(reinterpret_cast<const __m128i*>(h));
+  for (int k = 16; k < K; k += 16) mx = _mm_max_epu8(mx, _mm_loadu_si128(reinterpret_cast<const __m128i*>(h + k)));
+  mx = _mm_max_epu8(mx, _mm_srli_si128(mx, 8));
+  mx = _mm_max_epu8(mx, _mm_srli_si128(mx, 4));
+  mx = _mm_max_epu8(mx, _mm_srli_si128(mx, 2));
+  mx = _mm_max_epu8(mx, _mm_srli_si128(mx, 1));
+  mx = _mm_set1_epi8(char(_mm_cvtsi128_si32(mx) & 0xff));
+  for (int k = 0; k < K; k += 16) {
+    const int m = _mm_movemask_epi8(_mm_cmpeq_epi8(_mm_loadu_si128(reinterpret_cast<const __m128i*>(h + k)), mx));
+    if (m) return k + __builtin_ctz(unsigned(m));
+  }
+  return 0;
+}
 #else
-inline void hist_add(Count* h, const Count* c, int K) {
-  for (int k = 0; k < K; ++k) h[k] = Count(h[k] + c[k]);
+template <typename C>
+inline void hist_add(C* h, const C* c, int K) {
+  for (int k = 0; k < K; ++k) h[k] = C(h[k] + c[k]);
 }
-inline void hist_sub(Count* h, const Count* c, int K) {
-  for (int k = 0; k < K; ++k) h[k] = Count(h[k] - c[k]);
+template <typename C>
+inline void hist_sub(C* h, const C* c, int K) {
+  for (int k = 0; k < K; ++k) h[k] = C(h[k] - c[k]);
 }
-inline int hist_argmax(const Count* h, int K) {
+template <typename C>
+inline int hist_argmax(const C* h, int K) {
   int best = 0;
   for (int k = 1; k < K; ++k)
     if (h[k] > h[best]) best = k;
@@ -292,44 +410,57 @@ inline int hist_argmax(const Count* h, int K) {
 
 }  // namespace
 
-cv::Mat vote_clusters(const cv::Mat& bins, int num_bins, int n) {
+namespace {
+
+/// vote_clusters into `out` (its buffer reused when it has the size and type), with the column
+/// histograms in `col` (capacity reused).
+/// (Counts in C: uint16_t always, uint8_t for windows up to 15 x 15.)
+template <typename C>
+void vote_clusters_into(const cv::Mat& bins, int num_bins, int n, cv::Mat& out, std::vector<C>& col) {
   if (bins.type() != CV_8U) throw std::invalid_argument("vote_clusters: bins must be CV_8U");
   if (n < 1 || n % 2 == 0) throw std::invalid_argument("vote_clusters: window_size must be odd");
   if (num_bins < 1 || num_bins > 255) throw std::invalid_argument("vote_clusters: num_bins must be in [1, 255]");
+  if (sizeof(C) == 1 && n > 15) throw std::invalid_argument("vote_clusters: 8-bit counts need window_size <= 15");
   const int W = bins.cols, H = bins.rows, r = n / 2;
-  const int K = (num_bins + 7) / 8 * 8;  // whole vectors of 8 lanes
-  std::vector<Count> col(size_t(W) * size_t(K), 0);
+  constexpr int L = 16 / int(sizeof(C));     // lanes per vector
+  const int K = (num_bins + L - 1) / L * L;  // whole vectors
+  using Count = C;
+  col.assign(size_t(W) * size_t(K), 0);
   auto col_update = [&](int y, int delta) {
     const uint8_t* b = bins.ptr<uint8_t>(y);
     for (int x = 0; x < W; ++x)
       if (b[x] < num_bins) col[size_t(x) * size_t(K) + b[x]] = Count(col[size_t(x) * size_t(K) + b[x]] + delta);
   };
   for (int y = 0; y <= std::min(r, H - 1); ++y) col_update(y, +1);
-  cv::Mat out(bins.size(), CV_8U, cv::Scalar(255));
-  std::vector<Count> hist(size_t(K), 0);
+  out.create(bins.size(), CV_8U);
+  out.setTo(cv::Scalar(255));
+  Count hist_buf[256 + 16];  // K <= 256
+  Count* const hist = hist_buf;
   for (int y = 0; y < H; ++y) {
     if (y > 0) {
       if (y + r < H) col_update(y + r, +1);
       if (y - r - 1 >= 0) col_update(y - r - 1, -1);
     }
-    std::fill(hist.begin(), hist.end(), 0);
-    for (int x = 0; x <= std::min(r, W - 1); ++x) hist_add(hist.data(), &col[size_t(x) * size_t(K)], K);
+    std::fill(hist, hist + K, Count(0));
+    for (int x = 0; x <= std::min(r, W - 1); ++x) hist_add(hist, &col[size_t(x) * size_t(K)], K);
     const uint8_t* b = bins.ptr<uint8_t>(y);
     uint8_t* o = out.ptr<uint8_t>(y);
     for (int x = 0; x < W; ++x) {
-      if (b[x] < num_bins) o[x] = uint8_t(hist_argmax(hist.data(), K));
-      if (x + r + 1 < W) hist_add(hist.data(), &col[size_t(x + r + 1) * size_t(K)], K);
-      if (x - r >= 0) hist_sub(hist.data(), &col[size_t(x - r) * size_t(K)], K);
+      if (b[x] < num_bins) o[x] = uint8_t(hist_argmax(hist, K));
+      if (x + r + 1 < W) hist_add(hist, &col[size_t(x + r + 1) * size_t(K)], K);
+      if (x - r >= 0) hist_sub(hist, &col[size_t(x - r) * size_t(K)], K);
     }
   }
-  return out;
 }
 
-cv::Mat connected_regions(const cv::Mat& cls, int* count) {
+/// connected_regions into `lab` (its buffer reused when it has the size and type), with the union-find
+/// and the renumbering in `uf` and `remap` (capacity reused).
+void connected_regions_into(const cv::Mat& cls, int* count, cv::Mat& lab, UnionFind& uf, std::vector<int>& remap) {
   if (cls.type() != CV_8U) throw std::invalid_argument("connected_regions: input must be CV_8U");
   const int W = cls.cols, H = cls.rows;
-  cv::Mat lab(cls.size(), CV_32S, cv::Scalar(0));
-  UnionFind uf(1);
+  lab.create(cls.size(), CV_32S);
+  lab.setTo(cv::Scalar(0));
+  uf.reset(1);
   uf.parent.reserve(size_t(W) * size_t(H) / 4 + 16);
   int next = 1;
   for (int y = 0; y < H; ++y) {
@@ -356,7 +487,7 @@ cv::Mat connected_regions(const cv::Mat& cls, int* count) {
     }
   }
   // Compact numbering in raster order of first occurrence.
-  std::vector<int> remap(size_t(next), 0);
+  remap.assign(size_t(next), 0);
   int k = 0;
   for (int y = 0; y < H; ++y) {
     int* l = lab.ptr<int>(y);
@@ -368,8 +499,60 @@ cv::Mat connected_regions(const cv::Mat& cls, int* count) {
     }
   }
   if (count) *count = k;
+}
+
+}  // namespace
+
+cv::Mat vote_clusters(const cv::Mat& bins, int num_bins, int n) {
+  cv::Mat out;
+  std::vector<Count> col;
+  vote_clusters_into(bins, num_bins, n, out, col);
+  return out;
+}
+
+cv::Mat connected_regions(const cv::Mat& cls, int* count) {
+  cv::Mat lab;
+  UnionFind uf;
+  std::vector<int> remap;
+  connected_regions_into(cls, count, lab, uf, remap);
   return lab;
 }
+
+namespace {
+
+/// Scratch buffers of segment_god that live across frames (one per thread), so that a frame of the
+/// usual size reuses the previous frame's memory instead of faulting in fresh pages. Only capacity
+/// carries over: every buffer is sized and initialised per call as before.
+struct GodWorkspace {
+  cv::Mat bins, clusters, labels;
+  std::vector<Count> col;
+  std::vector<Count8> col8;
+  UnionFind cc_uf, uf;
+  std::vector<int> remap;
+  std::vector<Sums> mom, omom;
+  struct Run {
+    int x0, x1, label;
+  };
+  std::vector<Run> runs;
+  std::vector<size_t> row_start;
+  std::vector<uint64_t> edges, recent, edge_tmp, root_edges;
+  std::vector<int> edge_start, edge_stamp;
+  std::vector<Plane> planes, oplanes;
+  std::vector<uint8_t> fitted;
+  std::vector<std::tuple<double, int, int>> cand;
+  std::vector<char> touched;
+  std::vector<int> id_of_initial, id_of_root, root_of_id, todo, next_todo;
+  std::vector<std::pair<int, int>> grown;
+};
+
+/// An image buffer of the workspace for this call: dropped first if the caller still holds it (a
+/// returned label image), so a result is never overwritten by a later frame.
+cv::Mat& own(cv::Mat& m) {
+  if (m.u && m.u->refcount > 1) m.release();
+  return m;
+}
+
+}  // namespace
 
 SegmentationResult segment_god(const cv::Mat& image, const cv::Mat& points, const GodParams& params, GodDebug* debug) {
   params.validate();
@@ -380,21 +563,31 @@ SegmentationResult segment_god(const cv::Mat& image, const cv::Mat& points, cons
   if (params.merge_space == MergeSpace::kPoints && points.empty())
     throw std::invalid_argument("segment_god: merge_space 'points' needs the points image");
 
+  thread_local GodWorkspace ws;
   GodDebug local;
   GodDebug& dbg = debug ? *debug : local;
+  // Images: the debug output's own (fresh) images, else the workspace's.
+  cv::Mat& bins = debug ? dbg.bins : own(ws.bins);
+  cv::Mat& clusters = debug ? dbg.clusters : own(ws.clusters);
+  cv::Mat& init_labels = debug ? dbg.initial_labels : own(ws.labels);
   if (debug) {
     dbg.features = compute_god_features(image, params.gradient_step, params.flat_mgod_max);
     dbg.bins = god_bins(dbg.features, params.direction_bins, params.jump_mgod_min);
+    dbg.clusters.release();
+    dbg.initial_labels.release();
   } else {
     // Same bins without the DGoD/MGoD images (only the debug output needs them).
-    dbg.bins = god_bins_of_image(image, params.gradient_step, params.flat_mgod_max, params.direction_bins,
-                                 params.jump_mgod_min);
+    god_bins_of_image(image, params.gradient_step, params.flat_mgod_max, params.direction_bins, params.jump_mgod_min,
+                      bins);
   }
-  dbg.clusters = vote_clusters(dbg.bins, params.direction_bins + 1, params.window_size);
+  if (params.window_size <= 15)
+    vote_clusters_into(bins, params.direction_bins + 1, params.window_size, clusters, ws.col8);
+  else
+    vote_clusters_into(bins, params.direction_bins + 1, params.window_size, clusters, ws.col);
   int count = 0;
-  dbg.initial_labels = connected_regions(dbg.clusters, &count);
+  connected_regions_into(clusters, &count, init_labels, ws.cc_uf, ws.remap);
   dbg.initial_count = count;
-  const cv::Mat& init = dbg.initial_labels;
+  const cv::Mat& init = init_labels;
   const int W = image.cols, H = image.rows;
 
   // Merge-space point of a pixel: (x, y, value) in image space (no (x, y, value) image is built), else
@@ -416,8 +609,10 @@ SegmentationResult segment_god(const cv::Mat& image, const cv::Mat& points, cons
 
   // Moments of every initial segment in merge space and in the output points' space (raster order,
   // the same sums PointMoments::add would make). When the two spaces are one, one array serves both.
-  std::vector<Sums> mom(size_t(count) + 1), omom_own(same ? 0 : size_t(count) + 1);
-  std::vector<Sums>& omom = same ? mom : omom_own;
+  std::vector<Sums>& mom = ws.mom;
+  mom.assign(size_t(count) + 1, Sums());
+  if (!same) ws.omom.assign(size_t(count) + 1, Sums());
+  std::vector<Sums>& omom = same ? mom : ws.omom;
   for (int y = 0; y < H; ++y) {
     const int* l = init.ptr<int>(y);
     const float* v = image.ptr<float>(y);
@@ -440,12 +635,12 @@ SegmentationResult segment_god(const cv::Mat& image, const cv::Mat& points, cons
   // widened by R. An edge is not pushed again while it is in a small direct-mapped cache of recent
   // edges (most repeats come from the next rows); the rest of the repeats go in unique_edges.
   const int R = params.adjacency_radius_px;
-  struct Run {
-    int x0, x1, label;
-  };
-  std::vector<Run> runs;
+  using Run = GodWorkspace::Run;
+  std::vector<Run>& runs = ws.runs;
+  runs.clear();
   runs.reserve(size_t(count) * 8);
-  std::vector<size_t> row_start(size_t(H) + 1);
+  std::vector<size_t>& row_start = ws.row_start;
+  row_start.resize(size_t(H) + 1);
   for (int y = 0; y < H; ++y) {
     row_start[size_t(y)] = runs.size();
     const int* l = init.ptr<int>(y);
@@ -458,10 +653,12 @@ SegmentationResult segment_god(const cv::Mat& image, const cv::Mat& points, cons
     }
   }
   row_start[size_t(H)] = runs.size();
-  std::vector<uint64_t> edges;
+  std::vector<uint64_t>& edges = ws.edges;
+  edges.clear();
   edges.reserve(size_t(count) * 4);
   constexpr int kCacheBits = 11;
-  std::vector<uint64_t> recent(size_t(1) << kCacheBits, 0);  // 0 never is an edge (labels >= 1)
+  std::vector<uint64_t>& recent = ws.recent;
+  recent.assign(size_t(1) << kCacheBits, 0);  // 0 never is an edge (labels >= 1)
   const auto push = [&](int a, int b) {
     const uint64_t lo = uint64_t(std::min(a, b)), hi = uint64_t(std::max(a, b));
     const uint64_t e = (lo << 32) | hi;
@@ -486,20 +683,24 @@ SegmentationResult segment_god(const cv::Mat& image, const cv::Mat& points, cons
       }
     }
   }
-  std::vector<uint64_t> edge_tmp;
-  std::vector<int> edge_start, edge_stamp;
+  std::vector<uint64_t>& edge_tmp = ws.edge_tmp;
+  std::vector<int>&edge_start = ws.edge_start, &edge_stamp = ws.edge_stamp;
   unique_edges(edges, count, edge_tmp, edge_start, edge_stamp);
 
   // Iterative merging: each round merges the closest admissible pairs, each region at most once,
   // then refits; until a round merges nothing.
-  UnionFind uf(size_t(count) + 1);
-  std::vector<Plane> planes(size_t(count) + 1);
-  std::vector<Plane> oplanes(size_t(count) + 1);
+  UnionFind& uf = ws.uf;
+  uf.reset(size_t(count) + 1);
+  std::vector<Plane>& planes = ws.planes;
+  planes.assign(size_t(count) + 1, Plane());
+  std::vector<Plane>& oplanes = ws.oplanes;
+  oplanes.assign(same ? 0 : size_t(count) + 1, Plane());
   // Fitted lazily (most initial segments are never the larger region of a pair or gated).
-  std::vector<uint8_t> fitted(size_t(count) + 1, 0);  // bit 0: planes[i] current, bit 1: oplanes[i] current
+  std::vector<uint8_t>& fitted = ws.fitted;
+  fitted.assign(size_t(count) + 1, 0);  // bit 0: planes[i] current, bit 1: oplanes[i] current
   const auto plane = [&](int i) -> const Plane& {
     if (!(fitted[size_t(i)] & 1)) {
-      planes[size_t(i)] = fit_plane(mom[size_t(i)].moments());
+      planes[size_t(i)] = fit_plane_closed_form(mom[size_t(i)]);
       fitted[size_t(i)] |= 1;
     }
     return planes[size_t(i)];
@@ -507,7 +708,7 @@ SegmentationResult segment_god(const cv::Mat& image, const cv::Mat& points, cons
   const auto oplane = [&](int i) -> const Plane& {
     if (same) return plane(i);
     if (!(fitted[size_t(i)] & 2)) {
-      oplanes[size_t(i)] = fit_plane(omom[size_t(i)].moments());
+      oplanes[size_t(i)] = fit_plane_closed_form(omom[size_t(i)]);
       fitted[size_t(i)] |= 2;
     }
     return oplanes[size_t(i)];
@@ -515,9 +716,11 @@ SegmentationResult segment_god(const cv::Mat& image, const cv::Mat& points, cons
   const double cos_gate = std::cos(params.merge_max_angle_deg * M_PI / 180.0);
   const double gate_n = double(params.merge_angle_min_px);
   const double T = params.merge_distance;
-  std::vector<std::tuple<double, int, int>> cand;
-  std::vector<char> touched(size_t(count) + 1, 0);
-  std::vector<uint64_t> root_edges;
+  std::vector<std::tuple<double, int, int>>& cand = ws.cand;
+  std::vector<char>& touched = ws.touched;
+  touched.assign(size_t(count) + 1, 0);
+  std::vector<uint64_t>& root_edges = ws.root_edges;
+  root_edges.clear();
   root_edges.reserve(edges.size());
   dbg.merges = 0;
   dbg.merge_rounds = 0;
@@ -577,9 +780,11 @@ SegmentationResult segment_god(const cv::Mat& image, const cv::Mat& points, cons
   // label of its set, i.e. the set's first initial segment in raster order, so this numbering keeps the
   // order of the roots (the growth's tie-break) and describe_regions gets K instead of `count` slots.
   // Without debug output the initial labels are relabelled in place (reads precede writes per pixel).
-  cv::Mat labels = debug ? cv::Mat(image.size(), CV_32S) : dbg.initial_labels;
-  std::vector<int> id_of_initial(size_t(count) + 1, 0), id_of_root(size_t(count) + 1, 0);
-  std::vector<int> root_of_id(1, 0);
+  cv::Mat labels = debug ? cv::Mat(image.size(), CV_32S) : init_labels;
+  std::vector<int>&id_of_initial = ws.id_of_initial, &id_of_root = ws.id_of_root, &root_of_id = ws.root_of_id;
+  id_of_initial.assign(size_t(count) + 1, 0);
+  id_of_root.assign(size_t(count) + 1, 0);
+  root_of_id.assign(1, 0);
   for (int y = 0; y < H; ++y) {
     const int* l = init.ptr<int>(y);
     int* o = labels.ptr<int>(y);
@@ -608,9 +813,10 @@ SegmentationResult segment_god(const cv::Mat& image, const cv::Mat& points, cons
   // of the previous one. A pixel can only change in a step if a neighbour grew in the step before, so
   // after the first step (every unlabeled pixel) only the neighbours of the grown pixels are examined.
   if (params.boundary_growth_px > 0) {
-    std::vector<int> todo, next_todo;
-    std::vector<std::pair<int, int>> grown;  // (pixel index, label)
-    int* lab = labels.ptr<int>(0);           // continuous (created above)
+    std::vector<int>&todo = ws.todo, &next_todo = ws.next_todo;
+    std::vector<std::pair<int, int>>& grown = ws.grown;  // (pixel index, label)
+    todo.clear();
+    int* lab = labels.ptr<int>(0);  // continuous (created above)
     Eigen::Vector3d v;
     for (int y = 0; y < H; ++y)
       for (int x = 0; x < W; ++x)

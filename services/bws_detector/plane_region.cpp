@@ -50,6 +50,16 @@ cv::Mat image_space_points(const cv::Mat& image) {
 
 namespace {
 
+/// Moment sums as PointMoments::add makes them (same products, same order), the six distinct products.
+struct Acc {
+  int pixels = 0;
+  int x0 = std::numeric_limits<int>::max(), y0 = std::numeric_limits<int>::max(), x1 = -1, y1 = -1;
+  double n = 0.0, sx = 0.0, sy = 0.0, sz = 0.0, xx = 0.0, xy = 0.0, xz = 0.0, yy = 0.0, yz = 0.0, zz = 0.0;
+  Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
+  Eigen::Vector3d hi = Eigen::Vector3d::Constant(-std::numeric_limits<double>::infinity());
+  int first = -1;
+};
+
 SegmentationResult describe(const cv::Mat& labels, const cv::Mat& points, int min_pixels, bool in_place) {
   if (labels.type() != CV_32S) throw std::invalid_argument("describe_regions: labels must be CV_32S");
   if (points.type() != CV_32FC3 || points.size() != labels.size())
@@ -60,16 +70,10 @@ SegmentationResult describe(const cv::Mat& labels, const cv::Mat& points, int mi
     const int* l = labels.ptr<int>(y);
     for (int x = 0; x < labels.cols; ++x) max_label = std::max(max_label, l[x]);
   }
-  // Moment sums as PointMoments::add makes them (same products, same order), the six distinct products.
-  struct Acc {
-    int pixels = 0;
-    int x0 = std::numeric_limits<int>::max(), y0 = std::numeric_limits<int>::max(), x1 = -1, y1 = -1;
-    double n = 0.0, sx = 0.0, sy = 0.0, sz = 0.0, xx = 0.0, xy = 0.0, xz = 0.0, yy = 0.0, yz = 0.0, zz = 0.0;
-    Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
-    Eigen::Vector3d hi = Eigen::Vector3d::Constant(-std::numeric_limits<double>::infinity());
-    int first = -1;
-  };
-  std::vector<Acc> acc(size_t(max_label) + 1);
+  // Per-thread buffers that keep their capacity across calls (no fresh pages per frame).
+  thread_local std::vector<Acc> acc;
+  thread_local std::vector<int> order, remap;
+  acc.assign(size_t(max_label) + 1, Acc());
   for (int y = 0; y < labels.rows; ++y) {
     const int* l = labels.ptr<int>(y);
     const cv::Vec3f* p = points.ptr<cv::Vec3f>(y);
@@ -101,13 +105,13 @@ SegmentationResult describe(const cv::Mat& labels, const cv::Mat& points, int mi
       }
     }
   }
-  std::vector<int> order;
+  order.clear();
   for (int lab = 1; lab <= max_label; ++lab)
     if (acc[size_t(lab)].pixels > 0) order.push_back(lab);
   std::sort(order.begin(), order.end(), [&](int a, int b) { return acc[size_t(a)].first < acc[size_t(b)].first; });
 
   SegmentationResult out;
-  std::vector<int> remap(size_t(max_label) + 1, 0);
+  remap.assign(size_t(max_label) + 1, 0);
   for (int lab : order) {
     const Acc& a = acc[size_t(lab)];
     if (a.pixels < min_pixels) continue;

@@ -1,4 +1,6 @@
 // bench_bws: one 640x480 synthetic shelf stereo pair (seed 1), rendered once; every stage on the same input.
+#include <sys/resource.h>
+
 #include <benchmark/benchmark.h>
 
 #include "services/bws_detector/book_front_selection.h"
@@ -10,6 +12,12 @@
 using namespace bookgrasp::bws;
 
 namespace {
+/// Minor page faults of this thread so far.
+double minor_faults() {
+  rusage u{};
+  getrusage(RUSAGE_THREAD, &u);
+  return double(u.ru_minflt);
+}
 struct Input {
   test::ShelfScene scene = test::make_shelf_scene(1);
   cv::Mat left, right, disparity, points;
@@ -61,7 +69,9 @@ static void BM_GodSegmentation(benchmark::State& s) {
   auto& in = input();
   GodDebug dbg;  // counters from one run with debug output; the timed runs are the pipeline's (no debug)
   segment_god(in.disparity, in.points, in.gp, &dbg);
+  const double f0 = minor_faults();
   for (auto _ : s) benchmark::DoNotOptimize(segment_god(in.disparity, in.points, in.gp));
+  s.counters["faults"] = benchmark::Counter((minor_faults() - f0) / double(s.iterations()));
   s.counters["initial_segments"] = dbg.initial_count;
   s.counters["merge_rounds"] = dbg.merge_rounds;
 }
@@ -76,12 +86,14 @@ BENCHMARK(BM_PclSegmentation)->Unit(benchmark::kMillisecond);
 static void whole(benchmark::State& s, bool god) {
   auto& in = input();
   const ShelfVolume shelf{in.scene.shelf_box_in_base, in.scene.shelf_half_extent};
+  const double f0 = minor_faults();
   for (auto _ : s) {
     const cv::Mat d = compute_disparity(in.left, in.right, in.dp);
     const cv::Mat p = disparity_to_points(d, in.g);
     const SegmentationResult seg = god ? segment_god(d, p, in.gp) : segment_pcl_planes(p, in.pp);
     benchmark::DoNotOptimize(select_book_front(seg, p, in.g, in.scene.left.in_base, shelf, in.sp));
   }
+  s.counters["faults"] = benchmark::Counter((minor_faults() - f0) / double(s.iterations()));
 }
 static void BM_WholeBwS_God(benchmark::State& s) {
   whole(s, true);
