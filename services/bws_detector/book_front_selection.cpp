@@ -78,10 +78,54 @@ double quantile(std::vector<double>& v, double q) {
 }
 /// quantile(v, q) and quantile(v, 1 - q) (q <= 0.5): the upper one is selected among the elements
 /// above the lower one only (an order statistic is one value whatever the selection did before).
+///
+/// Exact, without moving `v` around: the values are counted into buckets of equal width between the
+/// minimum and the maximum (a monotone map, so equal values share a bucket and a bucket's values all lie
+/// between the previous and the next bucket's), and each order statistic is selected among the values
+/// of its bucket only. Falls back to nth_element on the whole array for non-finite values.
 std::pair<double, double> quantile_pair(std::vector<double>& v, double q) {
   const double nan = std::numeric_limits<double>::quiet_NaN();
   if (v.empty()) return {nan, nan};
   const size_t k0 = quantile_index(v.size(), q), k1 = quantile_index(v.size(), 1.0 - q);
+  const size_t n = v.size();
+  double lo = v[0], hi = v[0];
+  for (size_t i = 1; i < n; ++i) {
+    lo = std::min(lo, v[i]);
+    hi = std::max(hi, v[i]);
+  }
+  if (n >= 64 && std::isfinite(lo) && std::isfinite(hi) && std::isfinite(hi - lo)) {
+    if (lo == hi) return {lo, lo};
+    constexpr int kBuckets = 256;
+    const double scale = double(kBuckets) / (hi - lo);
+    const auto bucket = [&](double x) { return std::min(kBuckets - 1, int((x - lo) * scale)); };
+    size_t count[kBuckets] = {};
+    for (size_t i = 0; i < n; ++i) ++count[bucket(v[i])];
+    // Buckets holding ranks k0 and k1, and the rank of each bucket's first value.
+    int b0 = 0, b1 = 0;
+    size_t below0 = 0, below1 = 0, acc = 0;
+    for (int b = 0; b < kBuckets; ++b) {
+      if (acc <= k0 && k0 < acc + count[b]) {
+        b0 = b;
+        below0 = acc;
+      }
+      if (acc <= k1 && k1 < acc + count[b]) {
+        b1 = b;
+        below1 = acc;
+      }
+      acc += count[b];
+    }
+    thread_local std::vector<double> s0, s1;
+    s0.clear();
+    s1.clear();
+    for (size_t i = 0; i < n; ++i) {
+      const int b = bucket(v[i]);
+      if (b == b0) s0.push_back(v[i]);
+      if (b == b1) s1.push_back(v[i]);
+    }
+    std::nth_element(s0.begin(), s0.begin() + long(k0 - below0), s0.end());
+    std::nth_element(s1.begin(), s1.begin() + long(k1 - below1), s1.end());
+    return {s0[k0 - below0], s1[k1 - below1]};
+  }
   std::nth_element(v.begin(), v.begin() + long(k0), v.end());
   if (k1 > k0) std::nth_element(v.begin() + long(k0) + 1, v.begin() + long(k1), v.end());
   return {v[k0], v[k1]};

@@ -77,6 +77,15 @@ static void BM_GodSegmentation(benchmark::State& s) {
 }
 BENCHMARK(BM_GodSegmentation)->Unit(benchmark::kMillisecond);
 
+static void BM_BookFrontSelection(benchmark::State& s) {
+  auto& in = input();
+  const ShelfVolume shelf{in.scene.shelf_box_in_base, in.scene.shelf_half_extent};
+  const SegmentationResult seg = segment_god(in.disparity, in.points, in.gp);
+  for (auto _ : s)
+    benchmark::DoNotOptimize(select_book_front(seg, in.points, in.g, in.scene.left.in_base, shelf, in.sp));
+}
+BENCHMARK(BM_BookFrontSelection)->Unit(benchmark::kMillisecond);
+
 static void BM_PclSegmentation(benchmark::State& s) {
   auto& in = input();
   for (auto _ : s) benchmark::DoNotOptimize(segment_pcl_planes(in.points, in.pp));
