@@ -80,9 +80,17 @@ std::vector<channel_stats_t> to_stats(std::map<std::string, ChannelCounter>* cou
     s.channel = name;
     s.count = c.count;
     s.rejected = c.rejected;
-    s.rate_hz = period_s > 0 ? (c.count - c.count_at_last_report) / period_s : 0.0;
+    // Rate over the reports of the last kStatusRateWindowS (the first report: over its own period).
+    if (!c.report_history.empty() && now_utime > c.report_history.front().first)
+      s.rate_hz = static_cast<double>(c.count - c.report_history.front().second) /
+                  ((now_utime - c.report_history.front().first) * 1e-6);
+    else
+      s.rate_hz = period_s > 0 ? (c.count - c.count_at_last_report) / period_s : 0.0;
     s.age_s = c.last_stamp_utime > 0 ? (now_utime - c.last_stamp_utime) * 1e-6 : -1.0;
     c.count_at_last_report = c.count;
+    c.report_history.emplace_back(now_utime, c.count);
+    const int64_t window_start = now_utime - static_cast<int64_t>(kStatusRateWindowS * 1e6);
+    while (c.report_history.size() >= 2 && c.report_history[1].first <= window_start) c.report_history.pop_front();
     out.push_back(s);
   }
   return out;

@@ -6,10 +6,12 @@
 /// attaches it to a bus; the component never creates an LCM handle itself.
 
 #include <cstdint>
+#include <deque>
 #include <functional>
 #include <map>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <lcm/lcm-cpp.hpp>
@@ -24,7 +26,14 @@ struct ChannelCounter {
   int64_t rejected = 0;         ///< input messages that failed to decode or were refused
   int64_t last_stamp_utime = 0; ///< runtime clock at the last message (0 = none)
   int64_t count_at_last_report = 0;
+  /// (report utime, count) of the status reports of the last kStatusRateWindowS: the rate in
+  /// SERVICE_STATUS is over this window, so a 1 Hz stream reads 1 Hz, not 0 and 2 by turns.
+  std::deque<std::pair<int64_t, int64_t>> report_history;
 };
+
+/// SERVICE_STATUS rates are averaged over the status reports of this many seconds (or all since the
+/// start when fewer).
+inline constexpr double kStatusRateWindowS = 5.0;
 
 /// Base class of every service. A subclass declares its inputs in its
 /// constructor with subscribe() and publishes with publish(); the runtime

@@ -114,6 +114,42 @@ TEST(Composition, ServicePublishesStatusAndConfigInMessageTime) {
   EXPECT_EQ(config.got[0].config_yaml, kEchoYaml);
 }
 
+// A 1 Hz stream whose messages fall just before and just after the 1 s status reports by turns: the
+// status rate is averaged over kStatusRateWindowS, so it reads about 1 Hz instead of 0 and 2 by turns.
+TEST(Composition, StatusRateOfASlowJitteryStreamIsAveragedOverTheWindow) {
+  Composition comp;
+  const Config cfg = Config::from_string(kEchoYaml);
+  comp.add_service(std::make_unique<EchoComponent>(cfg), bookgrasp::ServiceSettings::from_config(cfg), kEchoYaml);
+  Collector<bookgrasp::service_status_t> status;
+  comp.bus().subscribe("SERVICE_STATUS", &Collector<bookgrasp::service_status_t>::on, &status);
+  // A 10 Hz image stream keeps message time going (status every second); IN comes at 1 Hz, 20 ms early and
+  // late by turns, so a 1 s period holds 0 or 2 of them by turns.
+  bookgrasp::image_t tick;
+  tick.width = tick.height = 1;
+  tick.size = 0;
+  int next_in = 1;
+  for (int t = 1; t <= 200; ++t) {
+    tick.utime = t * 100000;
+    const int64_t in_utime = next_in * 1000000 + 100000 + (next_in % 2 ? -20000 : 20000);  // reports at k + 0.1 s
+    if (in_utime < tick.utime) {                                                           // in message-time order
+      auto m = status_msg(in_utime, "t");
+      comp.bus().publish("IN", &m);
+      comp.spin();
+      ++next_in;
+    }
+    comp.bus().publish("IMAGES", &tick);
+    comp.spin();
+  }
+  ASSERT_GE(status.got.size(), 15u);
+  // Once the window is full, every report reads 1 Hz within one message per window.
+  for (size_t k = 7; k < status.got.size(); ++k) {
+    for (const auto& in : status.got[k].inputs) {
+      if (in.channel != "IN") continue;
+      EXPECT_NEAR(in.rate_hz, 1.0, 1.0 / bookgrasp::kStatusRateWindowS + 1e-9) << "report " << k;
+    }
+  }
+}
+
 TEST(Composition, SameInputSameOutputBitForBit) {
   auto run = [] {
     Composition comp;
