@@ -3,6 +3,9 @@
 # deploy/processes.txt, cameras publishing JPEG (so the log stays small), from the system's start
 # until N seconds of wall time after all services report alive.
 #   deploy/make_sample_log.sh OUT.lcm [SECONDS]
+# logs/samples/system_jpeg.lcm: `deploy/make_sample_log.sh logs/samples/system_jpeg.lcm 20` on an idle machine
+# (a loaded one drops frames and the replay tests then report them missing); the stereo camera at 4 Hz keeps the
+# 20 s (enough arbiter decisions for its replay test) at ~26 MB.
 set -euo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 OUT="$1"; SECONDS_TO_RECORD="${2:-3}"
@@ -12,7 +15,7 @@ export BOOKGRASP_LCM_URL="udpm://239.255.76.67:7611?ttl=0&recv_buf_size=4194304"
 cleanup() { "$ROOT/deploy/bookgrasp" stop >/dev/null 2>&1 || true; rm -rf "$TMP"; }
 trap cleanup EXIT
 # The same processes (deploy/processes.txt), the cameras publishing JPEG (a --set override).
-export BOOKGRASP_SET="${BOOKGRASP_SET:-} stereo_camera:image_encoding=jpeg hand_camera:image_encoding=jpeg"
+export BOOKGRASP_SET="${BOOKGRASP_SET:-} stereo_camera:image_encoding=jpeg hand_camera:image_encoding=jpeg stereo_camera:sim.frame_rate_hz=4"
 names=$(grep -v '^\s*#' "$ROOT/deploy/processes.txt" | sed '/^\s*$/d' | grep -vw standby | awk '{print $1}' | paste -sd, -)
 # The logger starts first, so the recording holds every input from the system's start: a replay then
 # sees exactly what the live processes saw (no state from before the log).

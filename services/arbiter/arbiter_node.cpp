@@ -79,6 +79,9 @@ ArbiterSettings ArbiterSettings::from_config(const Config& root) {
   s.max_slope_rad = root.get_double("gp.max_slope_deg", 0.0, 45.0) * M_PI / 180.0;
   s.width_settle_s = root.get_double("book_width.settle_s", 0.0, 10.0);
   s.width_settle_tolerance = root.get_double("book_width.settle_tolerance_m", 0.00001, 0.01);
+  s.width_open_margin = root.get_double("book_width.open_margin_m", 0.0, 0.05);
+  s.p1_arm_still_s = root.get_double("p1.arm_still_s", 0.0, 60.0);
+  s.p1_arm_still_joint_speed = root.get_double("p1.arm_still_joint_speed_rad_s", 0.0001, 10.0);
   return s;
 }
 
@@ -150,6 +153,11 @@ void ArbiterNode::on_book_corner(const book_corner_stereo_t& msg) {
   if (msg.implementation != follow_) return;  // another implementation: not followed now
   if (msg.found && !finite3(msg.p1_base)) {
     reject(s_.channels.book_corner_stereo, "found = true but p1_base is not finite");
+    return;
+  }
+  if (s_.p1_arm_still_s > 0 && last_arm_motion_utime_ &&
+      double(msg.utime - *last_arm_motion_utime_) < s_.p1_arm_still_s * 1e6) {
+    ++p1_skipped_arm_moving_;  // the arm moved at or just before this frame: it may be in the view
     return;
   }
   have_p1_msg_ = true;
@@ -355,12 +363,19 @@ void ArbiterNode::on_arm_state(const arm_state_t& msg) {
     reject(s_.channels.arm_state, "gripper_width_m is not finite");
     return;
   }
+  bool moving = msg.state == arm_state_t::EXECUTING;
+  for (double v : msg.velocities) moving = moving || !(std::abs(v) <= s_.p1_arm_still_joint_speed);
+  if (moving && (!last_arm_motion_utime_ || msg.utime > *last_arm_motion_utime_)) last_arm_motion_utime_ = msg.utime;
   if (!width_pending_) return;
   if (!msg.gripper_contact || msg.gripper_width_m <= 0) {
     settle_start_utime_ = -1;
     return;
   }
   const double w = msg.gripper_width_m;
+  if (w >= s_.size_limits.l_max - s_.width_open_margin) {  // open plates touching something: not the book yet
+    settle_start_utime_ = -1;
+    return;
+  }
   if (settle_start_utime_ < 0 || std::abs(w - settle_start_width_) > s_.width_settle_tolerance ||
       msg.utime < settle_start_utime_) {
     settle_start_utime_ = msg.utime;

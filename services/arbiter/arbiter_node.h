@@ -13,8 +13,11 @@
 ///   (`follow.implementation`, changed by DETECTOR_SWITCH). An *attempt* (one
 ///   try at one book) opens at start and after every GRASP or NO_GRASP decision
 ///   and every SERVO_REQUEST CANCEL; its P1 is frozen at the attempt's first
-///   non-cancel SERVO_REQUEST (the latest P1 before it, taken while the arm was
-///   out of the stereo view).
+///   non-cancel SERVO_REQUEST (the latest P1 before it). Only frames taken after
+///   the arm had been still for `p1.arm_still_s` count (ARM_STATE not EXECUTING
+///   and no joint faster than `p1.arm_still_joint_speed`): a frame taken while
+///   the arm moves in front of the shelf shows the arm, not the books; such a
+///   frame neither replaces the latest P1 nor makes a P1 check.
 /// - GRASP_POINT.reason starts with the outcome word:
 ///   `P1_VALID` / `P1_INVALID` (P1 check: on every followed BOOK_CORNER_STEREO
 ///   while P1 is not frozen and PS is known, and when a STRIPE_END servo
@@ -65,6 +68,10 @@ struct ArbiterSettings {
   double max_slope_rad = 0.2;           ///< larger servo slopes are not trusted (GP keeps the grasp orientation)
   double width_settle_s = 0.2;          ///< the plate distance must hold this long (message time) ...
   double width_settle_tolerance = 0.0005;  ///< ... within this, with contact, to count as the book width
+  double width_open_margin = 0.002;     ///< plates within this of L_max are open (touching a neighbour), not on a book
+  double p1_arm_still_s = 0.5;          ///< a P1 counts only from a frame taken this long after the arm last moved
+                                        ///< (0 = every frame)
+  double p1_arm_still_joint_speed = 0.01;  ///< rad/s: a joint faster than this means the arm moves
 
   /// Reads and validates every key; throws ConfigError naming a bad one.
   static ArbiterSettings from_config(const Config& root);
@@ -80,6 +87,10 @@ class ArbiterNode : public Component {
 
   /// The implementation of BOOK_CORNER_STEREO followed now.
   const std::string& followed_implementation() const { return follow_; }
+
+  /// Followed BOOK_CORNER_STEREO messages not used because their frame was taken while the
+  /// arm moved or within p1.arm_still_s after.
+  int64_t p1_skipped_arm_moving() const { return p1_skipped_arm_moving_; }
 
  private:
   void on_book_corner(const book_corner_stereo_t& msg);
@@ -115,6 +126,8 @@ class ArbiterNode : public Component {
   Eigen::Isometry3d last_frame_ = Eigen::Isometry3d::Identity();
   int64_t settle_start_utime_ = -1;
   double settle_start_width_ = 0;
+  std::optional<int64_t> last_arm_motion_utime_;  ///< latest ARM_STATE that showed the arm moving
+  int64_t p1_skipped_arm_moving_ = 0;
 };
 
 }  // namespace bookgrasp

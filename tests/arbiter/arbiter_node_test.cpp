@@ -197,13 +197,18 @@ TEST_F(ArbiterNodeTest, WholeBookP1ValidGraspWidthAndNextPs) {
   send("SERVO_STATUS", status(6100, 2, servo_request_t::BOOK_CORNER, servo_status_t::CONVERGED, {0.45, -0.31, 0.26}));
   EXPECT_EQ(out.got.size(), 3u);
 
+  // The open plates touch a neighbour while the gripper goes in (contact at the full opening, steady for
+  // 0.5 s): that is not the book's width.
+  send("ARM_STATE", arm(6200, 0.0601, true));
+  send("ARM_STATE", arm(506200, 0.0601, true));
+  EXPECT_EQ(out.got.size(), 3u) << "a steady width at the full opening (L_max) is not a book";
   // Gripper closes: contact at 25.4 mm (still closing), then 25.0 mm held for 0.3 s -> BW = 25 mm.
-  send("ARM_STATE", arm(7000, 0.040, false));
-  send("ARM_STATE", arm(8000, 0.0254, true));
-  send("ARM_STATE", arm(18000, 0.0250, true));
-  send("ARM_STATE", arm(118000, 0.0250, true));
+  send("ARM_STATE", arm(607000, 0.040, false));
+  send("ARM_STATE", arm(608000, 0.0254, true));
+  send("ARM_STATE", arm(618000, 0.0250, true));
+  send("ARM_STATE", arm(718000, 0.0250, true));
   EXPECT_EQ(out.got.size(), 3u) << "0.1 s steady is less than settle_s 0.2";
-  send("ARM_STATE", arm(318000, 0.0250, true));
+  send("ARM_STATE", arm(918000, 0.0250, true));
   ASSERT_EQ(out.got.size(), 4u);
   const grasp_point_t& bw = out.got[3];
   EXPECT_TRUE(starts_with(bw.reason, "BOOK_WIDTH")) << bw.reason;
@@ -211,14 +216,54 @@ TEST_F(ArbiterNodeTest, WholeBookP1ValidGraspWidthAndNextPs) {
   EXPECT_EQ(bw.request_id, 2);
   // PS.y = GP.y - BW = 0.26 - 0.025 = 0.235; x, z kept from PS.
   expect_vec(bw.ps_grasp, {0.10, 0.235, -0.15}, "next PS");
-  send("ARM_STATE", arm(400000, 0.0250, true));
+  send("ARM_STATE", arm(1000000, 0.0250, true));
   EXPECT_EQ(out.got.size(), 4u) << "the width is measured once per grasp";
 
   // Next book: P1 base (0.61, -0.285, 0.18) -> grasp (0.18, 0.235, 0.01): 0 mm from the updated PS.
-  send("BOOK_CORNER_STEREO", corner(500000, "god", true, {0.61, -0.285, 0.18}));
+  send("BOOK_CORNER_STEREO", corner(1100000, "god", true, {0.61, -0.285, 0.18}));
   ASSERT_EQ(out.got.size(), 5u);
   EXPECT_TRUE(starts_with(out.got[4].reason, "P1_VALID")) << out.got[4].reason;
   EXPECT_NEAR(out.got[4].steps[1].value_m, 0.0, kTol);
+}
+
+// A frame taken while the arm moves (or within p1.arm_still_s after) shows the arm in front of the shelf:
+// its P1 neither replaces the latest P1 nor makes a P1 check; the attempt freezes the P1 of the still arm.
+TEST_F(ArbiterNodeTest, P1FromAFrameTakenWhileTheArmMovedIsNotUsed) {
+  const double still_s = ArbiterSettings::from_config(arbiter_config()).p1_arm_still_s;
+  ASSERT_GT(still_s, 0.0);
+  const int64_t still_us = static_cast<int64_t>(still_s * 1e6);
+  first_run({0.61, -0.30, 0.25}, {0.45, -0.305, 0.10});  // P1 valid at utime 4000 (the arm never moved)
+  ASSERT_EQ(out.got.size(), 2u);
+  ASSERT_TRUE(starts_with(out.got[1].reason, "P1_VALID")) << out.got[1].reason;
+  // The arm moves (a joint at 0.5 rad/s) from t = 10 s to 12 s, then stands still.
+  arm_state_t a = arm(10000000, 0.05, false);
+  a.num_joints = 1;
+  a.joint_names = {"arm_1_joint"};
+  a.positions = {0.0};
+  a.velocities = {0.5};
+  for (int64_t t = 10000000; t <= 12000000; t += 500000) {
+    a.utime = t;
+    send("ARM_STATE", a);
+  }
+  a.velocities = {0.0};
+  a.state = arm_state_t::IDLE;
+  a.utime = 12010000;
+  send("ARM_STATE", a);
+  // A frame during the motion and one just after it (within still_s): a P1 180 mm to the left is ignored.
+  send("BOOK_CORNER_STEREO", corner(11000000, "god", true, {0.61, -0.12, 0.25}));
+  send("BOOK_CORNER_STEREO", corner(12000000 + still_us / 2, "god", true, {0.61, -0.12, 0.25}));
+  EXPECT_EQ(out.got.size(), 2u) << "no P1 check from a frame of the moving arm";
+  EXPECT_EQ(node->p1_skipped_arm_moving(), 2);
+  // The attempt's BwH request freezes the still arm's P1: BwH starts from it (P1_VALID earlier; GP uses P1.z).
+  send("SERVO_REQUEST", request(12000000 + still_us / 2 + 1000, 2, servo_request_t::BOOK_CORNER, 0));
+  send("SERVO_STATUS",
+       status(13000000, 2, servo_request_t::BOOK_CORNER, servo_status_t::CONVERGED, {0.45, -0.31, 0.26}));
+  ASSERT_EQ(out.got.size(), 3u);
+  EXPECT_TRUE(starts_with(out.got[2].reason, "GRASP")) << out.got[2].reason;
+  expect_vec(out.got[2].p1_grasp, {0.25, 0.25, 0.01}, "the still arm's P1");
+  // A frame taken still_s after the arm stopped counts again.
+  send("BOOK_CORNER_STEREO", corner(12010000 + still_us, "god", true, {0.61, -0.30, 0.25}));
+  EXPECT_EQ(node->p1_skipped_arm_moving(), 2);
 }
 
 TEST_F(ArbiterNodeTest, FalseRegionAsksForNextRankThenGrasps) {
