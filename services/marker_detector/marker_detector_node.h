@@ -5,7 +5,6 @@
 /// `base`, and the role of the cart and holder markers).
 
 #include <map>
-#include <optional>
 #include <string>
 #include <vector>
 
