@@ -491,6 +491,9 @@ struct FullCycleHarness::Impl {
       if (tb) {
         d.truth_known = true;
         d.p1_true_grasp = true_grasp(vec3(tb->p1_base));
+        const Eigen::Vector3d e = (d.gp_grasp - d.p1_true_grasp) * 1e3;
+        trace(fmt("TRUTH GP - true corner (%.1f, ", e.x()) + fmt("%.1f, ", e.y()) + fmt("%.1f) mm", e.z()) +
+              fmt(", book width %.1f mm", tb->width_m * 1e3));
       }
       res.decisions.push_back(d);
     } else if (word == "BOOK_WIDTH") {

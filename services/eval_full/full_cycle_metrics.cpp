@@ -95,6 +95,8 @@ void accumulate(const SceneOutcome& o, int max_books, const MetricTolerances& to
   for (const auto& b : r.books) m->holder_retreats += b.standing_on_holder >= 0 ? 1 : 0;
   m->holder_standing += r.holder_standing;
   for (const auto& d : r.decisions) {
+    if (d.truth_known)
+      for (int k = 0; k < 3; ++k) m->gp_error_mm[k].push_back((d.gp_grasp[k] - d.p1_true_grasp[k]) * 1e3);
     if (!d.p1_present) continue;
     ++m->decisions;
     const double dy = d.p2_grasp.y() - d.p1_grasp.y(), dx = d.p2_grasp.x() - d.p1_grasp.x();
@@ -153,6 +155,11 @@ std::string stats_json(const Stats& s) {
          ", \"p95\": " + num(s.p95) + ", \"max\": " + num(s.max) + "}";
 }
 
+/// Statistics of a signed sample: also its minimum.
+std::string signed_stats_json(const Stats& s) {
+  return stats_json(s).insert(1, "\"min\": " + num(s.min) + ", ");
+}
+
 }  // namespace
 
 std::string metrics_json(const EvalMetrics& m, const std::string& command) {
@@ -177,6 +184,9 @@ std::string metrics_json(const EvalMetrics& m, const std::string& command) {
   j << "  \"p1_error_mm\": {\"x\": " << stats_json(stats_of(m.p1_error_mm[0]))
     << ", \"y\": " << stats_json(stats_of(m.p1_error_mm[1])) << ", \"z\": " << stats_json(stats_of(m.p1_error_mm[2]))
     << "},\n";
+  j << "  \"gp_error_mm\": {\"x\": " << signed_stats_json(stats_of(m.gp_error_mm[0]))
+    << ", \"y\": " << signed_stats_json(stats_of(m.gp_error_mm[1]))
+    << ", \"z\": " << signed_stats_json(stats_of(m.gp_error_mm[2])) << "},\n";
   j << "  \"cycle_s\": " << stats_json(stats_of(m.cycle_s)) << ",\n";
   j << "  \"planning_ms\": " << stats_json(stats_of(m.plan_ms)) << ",\n";
   j << "  \"scene_wall_s\": " << stats_json(stats_of(m.scene_wall_s)) << ",\n";

@@ -54,10 +54,12 @@ SceneOutcome done_scene(uint64_t seed) {
   d.p1_present = true;
   d.p1_grasp = {0.20, 0.10, 0.01};
   d.p2_grasp = {0.21, 0.11, 0.01};  // dY 10 mm, dX 10 mm: agree
+  d.gp_grasp = {0.20, 0.11, 0.01};
   d.truth_known = true;
   d.p1_true_grasp = {0.204, 0.10, 0.013};
   GraspDecisionRecord e = d;
   e.p2_grasp = {0.20, 0.12, 0.01};  // dY 20 mm: disagree
+  e.gp_grasp = {0.20, 0.12, 0.01};
   GraspDecisionRecord no_p1;
   no_p1.p1_present = false;
   r.decisions = {d, e, no_p1};
@@ -97,6 +99,10 @@ TEST(FullCycleMetrics, AccumulatesRatesAndErrors) {
   ASSERT_EQ(m.p1_error_mm[0].size(), 2u);
   EXPECT_NEAR(m.p1_error_mm[0][0], 4.0, 1e-9);
   EXPECT_NEAR(m.p1_error_mm[2][0], 3.0, 1e-9);
+  // GP (signed, against the true corner) for every decision with truth, with a P1 or not.
+  ASSERT_EQ(m.gp_error_mm[1].size(), 2u);
+  EXPECT_NEAR(m.gp_error_mm[0][0], -4.0, 1e-9);
+  EXPECT_NEAR(m.gp_error_mm[1][1], 20.0, 1e-9);
   ASSERT_EQ(m.cycle_s.size(), 2u);
   EXPECT_DOUBLE_EQ(m.cycle_s[1], 120);
   // A retried grasp is a failure mode of its own, listed with the seed.
