@@ -68,6 +68,8 @@ ArbiterSettings ArbiterSettings::from_config(const Config& root) {
   s.tolerances.x = root.get_double("tolerances.x_m", 0.0001, 0.2);
   s.tolerances.max_rank = root.get_int("tolerances.max_rank", 1, 50);
   s.size_limits.l_max = root.get_double("gripper.l_max_m", 0.005, 0.5);
+  s.size_limits.tcp_offset_y =
+      root.get_double("gripper.tcp_offset_y_m", -s.size_limits.l_max / 2, s.size_limits.l_max / 2);
   s.cart_marker_role = root.get<std::string>("cart.marker_role");
   const std::vector<double> o = root.get_vector("cart.grasp_origin_in_marker_m", 3);
   s.grasp_origin_in_marker = Eigen::Vector3d(o[0], o[1], o[2]);

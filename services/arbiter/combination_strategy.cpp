@@ -136,8 +136,8 @@ ValidationStep check_book_width(double width, const BookSizeLimits& limits) {
     return step("book width", width, limits.s_max(), false, "book width is not a valid measurement");
   if (width > limits.s_max())
     return step("book width <= S_max", width, limits.s_max(), false,
-                "book wider than S_max = L_max/2 (" + mm(limits.s_max()) +
-                    "): a gripper centred on its right edge cannot close around it");
+                "book wider than S_max = L_max/2 - TCP offset (" + mm(limits.s_max()) +
+                    "): the open left plate lands on the book itself");
   if (width < limits.s_min())
     return step("book width >= S_min", width, limits.s_min(), false,
                 "book thinner than S_min = S_max/2 (" + mm(limits.s_min()) +

@@ -76,15 +76,19 @@ Eigen::Vector3d next_ps(const Eigen::Vector3d& ps, const Eigen::Vector3d& gp, do
 
 /// Book-size limits of Section 4.1, from the gripper's maximum opening L_max.
 struct BookSizeLimits {
-  double l_max = 0.06;                       ///< maximum gripper opening
-  double s_max() const { return l_max / 2; } ///< widest book graspable with the gripper centred on its edge
+  double l_max = 0.06;        ///< maximum gripper opening
+  double tcp_offset_y = 0.0;  ///< the gripper's middle right (+) of GP along Y (0 in the paper: on the right edge)
+  /// Widest book the open plates straddle: how far left of the right edge the left plate lands
+  /// (L_max/2 in the paper, where the gripper's middle is on the book's right edge).
+  double s_max() const { return l_max / 2 - tcp_offset_y; }
   double s_min() const { return s_max() / 2; }  ///< narrowest book the alternation rule assumes
 };
 
 /// Whether a book of `width` (metres) is admissible (Section 4.1): wider than
-/// S_max cannot be grasped centred on its right edge; narrower than S_min
+/// S_max, the open left plate lands on the book itself; narrower than S_min
 /// breaks the assumption that two neighbours together are at least S_max
-/// wide. Returns the step describing the check.
+/// wide (the left plate would reach the book after next). Returns the step
+/// describing the check.
 ValidationStep check_book_width(double width, const BookSizeLimits& limits);
 
 /// Name of an outcome ("GRASP", "NEXT_REGION", "NO_GRASP").

@@ -138,5 +138,15 @@ TEST(BookWidth, Section41Limits) {
   EXPECT_FALSE(check_book_width(kNan, lim).passed);
 }
 
+TEST(BookWidth, TheTcpOffsetMovesTheLeftPlateAndSoTheLimits) {
+  // The gripper's middle 15 mm left of GP (into the book): the left plate lands 45 mm left of the right edge.
+  const BookSizeLimits lim{0.06, -0.015};
+  EXPECT_DOUBLE_EQ(lim.s_max(), 0.045);
+  EXPECT_DOUBLE_EQ(lim.s_min(), 0.0225);
+  EXPECT_TRUE(check_book_width(0.033, lim).passed);
+  EXPECT_FALSE(check_book_width(0.046, lim).passed);
+  EXPECT_FALSE(check_book_width(0.020, lim).passed);
+}
+
 }  // namespace
 }  // namespace bookgrasp

@@ -110,9 +110,9 @@ namespace bookgrasp {
 namespace {
 
 // logs/samples/arbiter_seed5.lcm: the arbiter's inputs and outputs from the composed full-cycle harness
-// on seed 5 (bookgrasp_eval_full --scenes 1 --seed 5 --books 2 --stereo-hz 2 --log: two books through the whole
-// cycle), filtered to the arbiter's channels (BOOK_CORNER_STEREO, SERVO_STATUS, SERVO_REQUEST, MARKERS,
-// ARM_STATE, DETECTOR_SWITCH, GRASP_POINT); re-recorded 2026-12-02 after the arbiter's P1 gating.
+// on seed 5 (bookgrasp_eval_full --scenes 1 --seed 5 --scene config/scenes/default.yaml --books 2 --stereo-hz 2
+// --log: two books through the whole cycle), filtered to the arbiter's channels (BOOK_CORNER_STEREO,
+// SERVO_STATUS, SERVO_REQUEST, MARKERS, ARM_STATE, DETECTOR_SWITCH, GRASP_POINT); re-recorded 2026-12-02 after the TCP offset (S_max 45 mm).
 DiffReport replay_arbiter(const std::string& config_path) {
   const auto log = read_lcm_log(std::string(BOOKGRASP_SOURCE_DIR) + "/logs/samples/arbiter_seed5.lcm");
   std::vector<std::unique_ptr<Component>> cs;
