@@ -25,7 +25,8 @@ std::string driver_state_name(DriverState s) {
 ArmDriverCore::ArmDriverCore(ArmKinematics kinematics, ArmLimits limits, DriverParams params)
     : kin_(std::move(kinematics)), limits_(std::move(limits)), params_(params) {}
 
-void ArmDriverCore::on_measurement(int64_t now_utime, const Eigen::VectorXd& q, double gripper_width) {
+void ArmDriverCore::on_measurement(int64_t now_utime, const Eigen::VectorXd& q, double gripper_width,
+                                   bool gripper_contact) {
   if (now_utime > now_) now_ = now_utime;
   q_measured_ = q;
   if (q_cmd_.size() == 0) {
@@ -33,7 +34,7 @@ void ArmDriverCore::on_measurement(int64_t now_utime, const Eigen::VectorXd& q, 
     qd_cmd_ = Eigen::VectorXd::Zero(q.size());
     last_heard_ = now_;
   }
-  if (gripper_width_ < 0) gripper_width_ = hold_width(gripper_width);
+  if (gripper_width_ < 0) hold_gripper(gripper_width, gripper_contact);
 }
 
 Eigen::VectorXd ArmDriverCore::hold_posture(const Eigen::VectorXd& measured) const {
@@ -49,14 +50,23 @@ double ArmDriverCore::hold_width(double measured) const {
   return std::clamp(measured, params_.gripper_min_width, params_.gripper_max_width);
 }
 
-void ArmDriverCore::restart(int64_t now_utime, const Eigen::VectorXd& q, double gripper_width) {
+void ArmDriverCore::hold_gripper(double measured_width, bool contact) {
+  // Holding the measured width of plates that squeeze a book is holding it with no force at all: a driver
+  // restarted while the arm carried a book dropped it (tests/deploy/kill_restart_test.sh).
+  // Open plates touching a neighbour (within 3 mm of the full stroke) hold nothing: they stay open.
+  const bool holding = contact && measured_width < params_.gripper_max_width - 0.003;
+  gripper_width_ = holding ? params_.gripper_min_width : hold_width(measured_width);
+  gripper_force_ = holding ? params_.gripper_default_force : 0.0;
+}
+
+void ArmDriverCore::restart(int64_t now_utime, const Eigen::VectorXd& q, double gripper_width, bool gripper_contact) {
   now_ = now_utime;
   last_update_ = -1;
   last_heard_ = now_utime;
   q_measured_ = q;
   q_cmd_ = hold_posture(q);
   qd_cmd_ = Eigen::VectorXd::Zero(q.size());
-  gripper_width_ = hold_width(gripper_width);
+  hold_gripper(gripper_width, gripper_contact);
   stop("the arm's source restarted (simulation reset): motion stopped, holding the new position");
 }
 

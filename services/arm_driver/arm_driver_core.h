@@ -50,13 +50,16 @@ class ArmDriverCore {
   ArmDriverCore(ArmKinematics kinematics, ArmLimits limits, DriverParams params);
 
   /// New measurement of the arm at message time `now_utime` (from SIM_STATE or the hardware).
-  /// The first one initialises the setpoint to where the arm is.
-  void on_measurement(int64_t now_utime, const Eigen::VectorXd& q, double gripper_width);
+  /// The first one initialises the setpoint to where the arm is; the gripper's to its measured width, or,
+  /// when the plates are in contact short of fully open (`gripper_contact`: a driver restarted while they
+  /// hold a book), to closing with the default force, so what they hold is not let go.
+  void on_measurement(int64_t now_utime, const Eigen::VectorXd& q, double gripper_width, bool gripper_contact = false);
 
   /// The arm's source restarted (a restarted simulation: its clock jumped back and the arm is
   /// somewhere else): any motion stops (state STOPPED, with the reason) and the setpoint becomes
-  /// the new measurement, so the arm is never pulled back to where the old world had it.
-  void restart(int64_t now_utime, const Eigen::VectorXd& q, double gripper_width);
+  /// the new measurement (the gripper's as in on_measurement), so the arm is never pulled back to
+  /// where the old world had it.
+  void restart(int64_t now_utime, const Eigen::VectorXd& q, double gripper_width, bool gripper_contact = false);
 
   /// Executes `traj` from now. Returns "" if accepted, else why not (nothing changes then).
   std::string command_trajectory(const JointTrajectory& traj, int64_t command_id);
@@ -90,6 +93,8 @@ class ArmDriverCore {
  private:
   /// A measured plate distance as a gripper target: clamped to [gripper_min_width, gripper_max_width].
   double hold_width(double measured) const;
+  /// The gripper's setpoint from a measurement: hold the width, or keep squeezing what the plates touch.
+  void hold_gripper(double measured_width, bool contact);
   /// A measured posture as the held setpoint: clamped to the joint limits.
   Eigen::VectorXd hold_posture(const Eigen::VectorXd& measured) const;
   enum class Mode { kHold, kTrajectory, kCartesian };

@@ -117,10 +117,10 @@ void ArmDriverNode::on_sim_state(const sim_state_t& msg) {
   gripper_contact_ = msg.gripper_contact;
   if (order == TimeOrder::kRestarted) {
     report_error("SIM_STATE " + measure_order_.describe(msg.utime, order));
-    core_.restart(msg.utime, q, msg.gripper_width_m);
+    core_.restart(msg.utime, q, msg.gripper_width_m, msg.gripper_contact);
     last_setpoint_utime_ = -1;
   } else {
-    core_.on_measurement(msg.utime, q, msg.gripper_width_m);
+    core_.on_measurement(msg.utime, q, msg.gripper_width_m, msg.gripper_contact);
   }
   if (last_setpoint_utime_ >= 0 && (msg.utime - last_setpoint_utime_) * 1e-6 < setpoint_period_s_ - 1e-9) return;
   last_setpoint_utime_ = msg.utime;

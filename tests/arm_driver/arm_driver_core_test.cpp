@@ -80,6 +80,29 @@ TEST(ArmDriverCore, HoldsAMeasuredGripperWidthOnlyWithinTheStroke) {
   EXPECT_DOUBLE_EQ(d.update(kT0 + 2000).gripper_width, 0.031);
 }
 
+TEST(ArmDriverCore, ARestartedDriverKeepsSqueezingWhatThePlatesHold) {
+  // Started (or its source restarted) while the plates touch something (a book 24.8 mm wide): the setpoint
+  // keeps closing with force; holding the measured width would hold the book with no force and drop it.
+  const DriverParams p;
+  ArmDriverCore d = make_core();
+  d.on_measurement(kT0, home(), 0.0248, true);
+  DriverSetpoint sp = d.update(kT0);
+  EXPECT_DOUBLE_EQ(sp.gripper_width, p.gripper_min_width);
+  EXPECT_DOUBLE_EQ(sp.gripper_force, p.gripper_default_force);
+  d.restart(kT0 + 1000, home(), 0.0248, true);
+  sp = d.update(kT0 + 1000);
+  EXPECT_DOUBLE_EQ(sp.gripper_width, p.gripper_min_width);
+  EXPECT_GT(sp.gripper_force, 0);
+  // Without contact the plates stay where they are.
+  ArmDriverCore free = make_core();
+  free.on_measurement(kT0, home(), 0.0248, false);
+  EXPECT_DOUBLE_EQ(free.update(kT0).gripper_width, 0.0248);
+  // Open plates that touch a neighbour hold nothing: they stay open.
+  ArmDriverCore open = make_core();
+  open.on_measurement(kT0, home(), 0.060, true);
+  EXPECT_DOUBLE_EQ(open.update(kT0).gripper_width, 0.060);
+}
+
 TEST(ArmDriverCore, HoldsAMeasuredPostureOnlyWithinTheJointLimits) {
   // A restarted driver finds the elbow pushed 0.01 rad past its limit: it holds the limit itself,
   // a setpoint the arm accepts, not the measured value.

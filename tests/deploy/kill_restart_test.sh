@@ -3,8 +3,9 @@
 # (the library task runs), kill the coordinator during a planned arm motion and check that the arm
 # driver stops (its heartbeats end) and the restarted coordinator resumes; then kill -9 each process
 # in turn and check that supervisord restarts it (a new pid reports on the bus), that the others keep
-# reporting, that nobody rejects input because a neighbour restarted, and (the simulation's truth, before
-# the simulation itself is killed last) that no book fell off while the others were killed.
+# reporting, that nobody rejects input because a neighbour restarted, and (the simulation's truth) that no
+# book falls off: the per-process kills start once a book is in the gripper and every kill is followed by a
+# truth check (before the simulation itself is killed last, which resets the world).
 #   kill_restart_test.sh SOURCE_DIR BUILD_DIR
 set -euo pipefail
 SRC="$1"; BUILD="$2"
@@ -44,7 +45,10 @@ fi
 # the task in progress acts on a world that jumped (its next trajectory starts where the arm no longer
 # is, and the driver rightly refuses it). Right after that restart nobody may reject input; the kills
 # that follow it would no longer test a neighbour's restart but a teleported world.
-order="$(grep -vx sim_world <<< "$(tr ' ' '\n' <<< "$names")" | paste -sd' ' -)"
+# The processes that move the book first, while it is most likely still in the plates (the rest take ~5 s each).
+first="coordinator arm_driver planner"
+order="$(for n in $first; do grep -x "$n" <<< "$(tr ' ' '\n' <<< "$names")" || true; done | paste -sd' ' -)"
+order="$order $(grep -vxE "sim_world|${first// /|}" <<< "$(tr ' ' '\n' <<< "$names")" | paste -sd' ' -)"
 grep -qx sim_world <<< "$(tr ' ' '\n' <<< "$names")" && order="$order sim_world"
 # Where every book is, from the simulation's truth: "id:place ..." (places: upper_shelf, holder, lower_shelf,
 # gripper, other).
@@ -60,6 +64,21 @@ book_places() {
 }
 places_before=$(book_places) || fail "no SIM_GROUND_TRUTH with books on the bus"
 echo "books before the kills: $places_before"
+task_state() {
+  "$ECHO" --lcm-url "$BOOKGRASP_LCM_URL" --channel TASK_STATUS --count 1 --field state --field message --timeout 5 \
+    2>/dev/null | head -c 300 || true
+}
+# The kills that matter most happen with a book in the plates: wait (truth) until the cycle has grasped one.
+held=""
+for _ in $(seq 300); do
+  places=$(book_places) || places=""
+  held=$(grep -o '[0-9]*:gripper' <<< "$places" | head -1 | cut -d: -f1) || true
+  [ -n "$held" ] && break
+  ! grep -q ':other' <<< "$places" || fail "a book fell (place other) before any kill: $places"
+  sleep 1
+done
+[ -n "$held" ] || fail "no book reached the gripper within 300 s; books: $places; task: $(task_state)"
+echo "book $held is in the gripper ($(task_state)): every process is killed in turn while the cycle carries it"
 for name in $order; do
   if [ "$name" = sim_world ]; then
     # Before the simulation itself restarts (which resets the world): no book was lost while every other
@@ -85,6 +104,9 @@ for name in $order; do
   rejecting=$(awk 'NR > 1 && $1 != "all" && $8 ~ /^[0-9]+$/ && $8 > 0 {print $1 " (" $8 ")"}' "$TMP/table.txt")
   [ -z "$rejecting" ] || fail "after killing $name these services reject input: $rejecting
 $(grep -E "^($(echo "$rejecting" | awk '{print $1}' | paste -sd'|' -)) " "$TMP/table.txt")"
-  echo "killed $name (pid $old): restarted as pid $new, all $(echo $names | wc -w) services reporting"
+  places=$(book_places) || fail "no SIM_GROUND_TRUTH with books on the bus after killing $name"
+  ! grep -q ':other' <<< "$places" || fail "after killing $name a book was lost (place other): $places"
+  echo "killed $name (pid $old): restarted as pid $new, all $(echo $names | wc -w) services reporting;" \
+    "book $held is $(grep -o "\b$held:[a-z_]*" <<< "$places" | cut -d: -f2); task: $(task_state)"
 done
 echo "PASS"
