@@ -128,8 +128,8 @@ int main(int argc, char** argv) {
     accumulate(outcome, books, tol, &metrics);
     const FullCycleResult& r = outcome.result;
     const std::string why = failure_reason(r, books);
-    csv << s << "," << r.end << "," << r.books_on_upper_shelf << "," << r.books_moved << "," << r.grasp_attempts
-        << "," << r.grasp_successes << "," << r.sim_s << "," << r.wall_s << ",\"" << why << "\"\n";
+    csv << s << "," << r.end << "," << r.books_on_upper_shelf << "," << books_on_lower_shelf(r) << ","
+        << r.grasp_attempts << "," << r.grasp_successes << "," << r.sim_s << "," << r.wall_s << ",\"" << why << "\"\n";
     csv.flush();
     if (!why.empty() || verbose) {
       std::ofstream tr(out + "/trace_seed_" + std::to_string(s) + ".txt");
@@ -143,7 +143,8 @@ int main(int argc, char** argv) {
       std::cerr << progress_bar(k + 1, scenes, eta, static_cast<int>(metrics.failures.size())) << std::flush;
     else
       std::cerr << "scene " << (k + 1) << "/" << scenes << " seed " << s << ": " << r.end << ", moved "
-                << r.books_moved << ", " << r.wall_s << " s wall" << (why.empty() ? "" : " FAILED: " + why) << "\n";
+                << books_on_lower_shelf(r) << ", " << r.wall_s << " s wall" << (why.empty() ? "" : " FAILED: " + why)
+                << "\n";
   }
   if (tty) std::cerr << "\n";
   write_report(out, metrics, cmd.str(), books);

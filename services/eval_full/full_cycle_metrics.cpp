@@ -36,6 +36,18 @@ std::string first_words(const std::string& msg, int words) {
 
 }  // namespace
 
+std::string final_place(const FullCycleResult& r, const BookRecord& b) {
+  for (const auto& t : r.final_truth.books)
+    if (t.id == b.truth_id) return t.place;
+  return "unknown";
+}
+
+int books_on_lower_shelf(const FullCycleResult& r) {
+  int n = 0;
+  for (const auto& b : r.books) n += b.moved && final_place(r, b) == "lower_shelf" ? 1 : 0;
+  return n;
+}
+
 std::string failure_reason(const FullCycleResult& r, int max_books) {
   if (r.end == "ERROR") return "ERROR: " + r.message;
   for (const auto& b : r.books)
@@ -44,6 +56,10 @@ std::string failure_reason(const FullCycleResult& r, int max_books) {
              (b.grasp_successes == 0 ? " (it was not in the plates after EXTRACT)" : "");
   for (const auto& b : r.books)
     if (b.standing_on_holder == 0) return "BOOK_NOT_STANDING_ON_HOLDER after RETREAT_FROM_HOLDER";
+  for (const auto& b : r.books) {
+    const std::string place = final_place(r, b);
+    if (b.moved && place != "lower_shelf") return "BOOK_NOT_ON_LOWER_SHELF at the end: the book is " + place;
+  }
   if (r.end == "ABORTED") {
     // "aborted in STATE: book 0: 3 attempts failed (...), last: <cause>": class = state + cause.
     const auto in = r.message.find("aborted in ");
@@ -87,7 +103,9 @@ void accumulate(const SceneOutcome& o, int max_books, const MetricTolerances& to
   m->scene_wall_s.push_back(r.wall_s);
   const int targeted = max_books > 0 ? std::min(max_books, r.books_on_upper_shelf) : r.books_on_upper_shelf;
   m->books_targeted += targeted;
-  m->books_moved += std::min(r.books_moved, targeted > 0 ? targeted : r.books_moved);
+  // A book counts as moved when the coordinator says so and the simulation's truth has it on the lower shelf.
+  const int moved = books_on_lower_shelf(r);
+  m->books_moved += std::min(moved, targeted > 0 ? targeted : moved);
   m->grasp_attempts += r.grasp_attempts;
   m->grasp_successes += r.grasp_successes;
   m->holder_releases += r.holder_releases;

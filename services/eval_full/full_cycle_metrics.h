@@ -60,8 +60,15 @@ struct EvalMetrics {
   std::map<std::string, int> failure_modes;  ///< reason class -> count
 };
 
+/// Where the simulation's truth has book `b` at the end of the scene ("unknown" if it has no such book).
+std::string final_place(const FullCycleResult& r, const BookRecord& b);
+
+/// Books the coordinator moved (TASK_STATUS books_moved) that the truth has on the lower shelf at the end.
+int books_on_lower_shelf(const FullCycleResult& r);
+
 /// The failure class of a scene ("" = none): ERROR, BOOK_NOT_ON_HOLDER (a released book that the truth does not
-/// place on the holder: named before the abort it leads to), ABORTED: <state>, BUDGET in <state>, GRASP_RETRIED, ...
+/// place on the holder: named before the abort it leads to), BOOK_NOT_ON_LOWER_SHELF (a book the coordinator
+/// moved that the truth does not have on the lower shelf), ABORTED: <state>, BUDGET in <state>, GRASP_RETRIED, ...
 std::string failure_reason(const FullCycleResult& r, int max_books);
 
 /// Accumulates `outcome` into `m` (max_books as given to the harness, 0 = all books).

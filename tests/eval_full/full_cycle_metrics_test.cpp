@@ -8,8 +8,9 @@ using namespace bookgrasp;
 
 namespace {
 
-book_truth_t truth_book(const std::string& place) {
+book_truth_t truth_book(const std::string& place, int id = 0) {
   book_truth_t b{};
+  b.id = id;
   b.place = place;
   return b;
 }
@@ -26,7 +27,7 @@ SceneOutcome done_scene(uint64_t seed) {
   r.holder_releases = 2;
   r.holder_placed = 2;
   r.holder_standing = 2;
-  r.final_truth.books = {truth_book("lower_shelf"), truth_book("lower_shelf")};
+  r.final_truth.books = {truth_book("lower_shelf", 0), truth_book("lower_shelf", 1)};
   r.final_truth.num_books = 2;
   BookRecord a;
   a.truth_id = 0;
@@ -109,6 +110,21 @@ TEST(FullCycleMetrics, AccumulatesRatesAndErrors) {
   ASSERT_EQ(m.failures.size(), 1u);
   EXPECT_EQ(m.failures[0].first, 7u);
   EXPECT_NE(m.failures[0].second.find("GRASP_RETRIED"), std::string::npos);
+}
+
+TEST(FullCycleMetrics, AMovedBookCountsOnlyIfTheTruthHasItOnTheLowerShelf) {
+  // The coordinator moved two books; the truth has the second in front of the cart (fallen off the lower shelf).
+  SceneOutcome o = done_scene(4);
+  o.result.end = "BOOKS";
+  o.result.final_truth.books[1].place = "other";
+  EXPECT_EQ(books_on_lower_shelf(o.result), 1);
+  EXPECT_EQ(final_place(o.result, o.result.books[1]), "other");
+  EXPECT_EQ(failure_reason(o.result, 2), "BOOK_NOT_ON_LOWER_SHELF at the end: the book is other");
+  EvalMetrics m;
+  accumulate(o, 2, MetricTolerances{}, &m);
+  EXPECT_EQ(m.books_moved, 1);
+  ASSERT_EQ(m.failures.size(), 1u);
+  EXPECT_EQ(m.failures[0].second, "BOOK_NOT_ON_LOWER_SHELF at the end: the book is other");
 }
 
 TEST(FullCycleMetrics, FailureReasons) {
