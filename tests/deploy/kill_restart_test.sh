@@ -20,6 +20,8 @@ CONF="$TMP/run/supervisord.conf"
 cleanup() { "$FRONT" stop >/dev/null 2>&1 || true; rm -rf "$TMP"; }
 trap cleanup EXIT
 fail() { echo "FAIL: $*"; tail -5 "$TMP/run/"*.log 2>/dev/null; exit 1; }
+# A command that fails outside a `|| fail` says where (set -e would otherwise end the test silently).
+trap 'echo "FAIL: line $LINENO: \"$BASH_COMMAND\" exited non-zero"; tail -5 "$TMP/run/"*.log 2>/dev/null' ERR
 
 names=$(grep -v '^\s*#' "$SRC/deploy/processes.txt" | sed '/^\s*$/d' | grep -vw standby | awk '{print $1}')
 all=$(echo $names | tr ' ' ',')
@@ -31,7 +33,8 @@ if grep -qw coordinator <<< "$names"; then
     --field state --timeout 90 >/dev/null || fail "the coordinator never reached MOVE_TO_STRIPE_START"
   "$ECHO" --lcm-url "$BOOKGRASP_LCM_URL" --channel ARM_STATE --until state=1 --quiet --field state \
     --timeout 10 >/dev/null || fail "the arm did not execute the move to the stripe station"
-  old=$(supervisorctl -c "$CONF" pid coordinator)
+  old=$(supervisorctl -c "$CONF" pid coordinator) || old=0
+  [[ "$old" =~ ^[1-9][0-9]*$ ]] || fail "supervisord has no running coordinator: $(supervisorctl -c "$CONF" status coordinator 2>&1)"
   kill -9 "$old"
   # Heartbeat timeout 0.5 s (arm_driver.yaml): the driver stops long before a new coordinator is up.
   "$ECHO" --lcm-url "$BOOKGRASP_LCM_URL" --channel ARM_STATE --until state!=1 --quiet --field state --field message \
@@ -88,12 +91,21 @@ for name in $order; do
     [ "$(wc -w <<< "$places_after")" = "$(wc -w <<< "$places_before")" ] || fail "the number of books changed"
     ! grep -q ':other' <<< "$places_after" || fail "a book was lost (place other): $places_after"
   fi
-  old=$(supervisorctl -c "$CONF" pid "$name")
+  # A pid of 0 (the process between a crash of its own and supervisord's restart) must never reach kill -9:
+  # `kill -9 0` kills this script's own process group. Wait for the running one.
+  old=0
+  for _ in $(seq 100); do
+    old=$(supervisorctl -c "$CONF" pid "$name" 2>/dev/null) || old=0
+    [[ "$old" =~ ^[1-9][0-9]*$ ]] && break
+    old=0
+    sleep 0.3
+  done
+  [ "$old" -gt 0 ] || fail "supervisord has no running $name to kill: $(supervisorctl -c "$CONF" status "$name" 2>&1)"
   kill -9 "$old"
   new=$old
   for _ in $(seq 300); do
-    new=$(supervisorctl -c "$CONF" pid "$name")
-    [ "$new" -gt 0 ] && [ "$new" != "$old" ] && break
+    new=$(supervisorctl -c "$CONF" pid "$name" 2>/dev/null) || new=0
+    [[ "$new" =~ ^[1-9][0-9]*$ ]] && [ "$new" != "$old" ] && break
     sleep 0.1
   done
   [ "$new" != "$old" ] || fail "$name was not restarted after kill -9"
