@@ -72,15 +72,27 @@ task_state() {
     2>/dev/null | head -c 300 || true
 }
 # The kills that matter most happen with a book in the plates: wait (truth) until the cycle has grasped one.
+# The deployed cycle runs on wall time and does not reach a grasp in every run (docs/EVALUATION.md): a task that
+# ABORTED before any grasp is started afresh, as an operator would (at most twice).
 held=""
-for _ in $(seq 300); do
+fresh_starts=0
+deadline=$((SECONDS + 420))
+while [ "$SECONDS" -lt "$deadline" ]; do
   places=$(book_places) || places=""
   held=$(grep -o '[0-9]*:gripper' <<< "$places" | head -1 | cut -d: -f1) || true
   [ -n "$held" ] && break
   ! grep -q ':other' <<< "$places" || fail "a book fell (place other) before any kill: $places"
+  state=$(task_state)
+  if grep -q 'state="ABORTED"' <<< "$state" && [ "$fresh_starts" -lt 2 ]; then
+    echo "the task ABORTED before a grasp, started afresh: $state"
+    supervisorctl -c "$CONF" stop coordinator >/dev/null
+    rm -f "$TMP/run/coordinator_progress.yaml"
+    supervisorctl -c "$CONF" start coordinator >/dev/null
+    fresh_starts=$((fresh_starts + 1))
+  fi
   sleep 1
 done
-[ -n "$held" ] || fail "no book reached the gripper within 300 s; books: $places; task: $(task_state)"
+[ -n "$held" ] || fail "no book reached the gripper within 420 s ($fresh_starts fresh starts); books: $places; task: $(task_state)"
 echo "book $held is in the gripper ($(task_state)): every process is killed in turn while the cycle carries it"
 for name in $order; do
   if [ "$name" = sim_world ]; then
