@@ -449,6 +449,16 @@ void LibraryCycle::handle_gripper_result(double width, bool contact) {
   motion_done();
 }
 
+bool LibraryCycle::book_lost_from_plates() {
+  if (!arm_ || arm_->gripper_contact || arm_->gripper_width >= s_.min_book_width) return false;
+  // The plates closed on nothing while they carried the book (a grasp too near its top edge): it fell. Where it
+  // lies is unknown; carrying on would place and release empty plates and count a book that is not there.
+  abort("book " + std::to_string(progress_.books_moved) + " is not in the gripper after " + cycle_state_name(state_) +
+        " (no contact, plates at " + std::to_string(arm_->gripper_width * 1000.0) +
+        " mm): it fell out; find it, correct the progress file, restart");
+  return true;
+}
+
 void LibraryCycle::motion_done() {
   motion_ = Motion{};
   after_motion();
@@ -483,18 +493,11 @@ void LibraryCycle::after_motion() {
       succeed(CycleState::kExtract);
       return;
     case CycleState::kExtract:
-      if (arm_ && !arm_->gripper_contact && arm_->gripper_width < s_.min_book_width) {
-        // The book slipped out while it was pulled out (a grasp too near its top edge): the plates
-        // closed on nothing. Where it lies is unknown; carrying on would take empty plates to the holder.
-        abort("book " + std::to_string(progress_.books_moved) +
-              " is not in the gripper after EXTRACT (no contact, plates at " +
-              std::to_string(arm_->gripper_width * 1000.0) +
-              " mm): it slipped out; find it, correct the progress file, restart");
-        return;
-      }
+      if (book_lost_from_plates()) return;
       succeed(CycleState::kMoveToHolder);
       return;
     case CycleState::kMoveToHolder:
+      if (book_lost_from_plates()) return;
       succeed(CycleState::kPlaceOnHolder);
       return;
     case CycleState::kPlaceOnHolder:
@@ -524,12 +527,15 @@ void LibraryCycle::after_motion() {
       succeed(CycleState::kLiftFromHolder);
       return;
     case CycleState::kLiftFromHolder:
+      if (book_lost_from_plates()) return;
       succeed(CycleState::kMoveToLowerShelf);
       return;
     case CycleState::kMoveToLowerShelf:
+      if (book_lost_from_plates()) return;
       succeed(CycleState::kPlaceOnLowerShelf);
       return;
     case CycleState::kPlaceOnLowerShelf:
+      if (book_lost_from_plates()) return;
       succeed(CycleState::kReleaseOnLowerShelf);
       return;
     case CycleState::kReleaseOnLowerShelf: {

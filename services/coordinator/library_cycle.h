@@ -288,6 +288,9 @@ class LibraryCycle {
   void start_gripper(bool grasp);
   void issue_plan();
   void drive_motion(const ArmEvent& e);
+  /// After a move that carries the book: if the plates closed on nothing (no contact, narrower than
+  /// min_book_width), aborts naming the state ("book N is not in the gripper after STATE") and returns true.
+  bool book_lost_from_plates();
   void motion_done();
   void after_motion();
   CycleState resume_target() const;

@@ -463,6 +463,25 @@ TEST(LibraryCycle, ABookThatSlipsOutDuringExtractAbortsInsteadOfCarryingEmptyPla
   EXPECT_EQ(count(w.states, "MOVE_TO_HOLDER"), 0);
 }
 
+TEST(LibraryCycle, ABookThatFallsOnTheWayToTheLowerShelfAbortsInsteadOfPlacingEmptyPlates) {
+  // far_cart seed 5 (docs/EVALUATION.md): regrasped 11 mm above its top at the holder, the book fell during
+  // MOVE_TO_LOWER_SHELF and the cycle placed, released and counted empty plates.
+  FakeLibrary w(three_books());
+  LibraryCycle c(settings(), std::nullopt);
+  w.run(c, [&] { return c.state() == CycleState::kMoveToLowerShelf; });
+  ASSERT_EQ(c.state(), CycleState::kMoveToLowerShelf);
+  w.contact = false;
+  w.width = 0.0;
+  w.in_gripper.reset();
+  w.run(c, [&] { return done_or_aborted(c); });
+  ASSERT_EQ(c.state(), CycleState::kAborted);
+  EXPECT_NE(c.status().message.find("not in the gripper after MOVE_TO_LOWER_SHELF"), std::string::npos)
+      << c.status().message;
+  EXPECT_EQ(count(w.states, "RELEASE_ON_LOWER_SHELF"), 0);
+  EXPECT_EQ(c.status().books_moved, 0);
+  EXPECT_TRUE(w.lower.empty());
+}
+
 TEST(LibraryCycle, ResumeWithABookExpectedInTheGripperButNoContactAborts) {
   FakeLibrary w(three_books());
   LibraryCycle first(settings(), std::nullopt);
