@@ -53,8 +53,8 @@ double ArmDriverCore::hold_width(double measured) const {
 void ArmDriverCore::hold_gripper(double measured_width, bool contact) {
   // Holding the measured width of plates that squeeze a book is holding it with no force at all: a driver
   // restarted while the arm carried a book dropped it (tests/deploy/kill_restart_test.sh).
-  // Open plates touching a neighbour (within 3 mm of the full stroke) hold nothing: they stay open.
-  const bool holding = contact && measured_width < params_.gripper_max_width - 0.003;
+  // Open plates touching a neighbour (within gripper_open_margin of the full stroke) hold nothing: they stay open.
+  const bool holding = contact && measured_width < params_.gripper_max_width - params_.gripper_open_margin;
   gripper_width_ = holding ? params_.gripper_min_width : hold_width(measured_width);
   gripper_force_ = holding ? params_.gripper_default_force : 0.0;
 }

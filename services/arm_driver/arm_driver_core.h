@@ -33,6 +33,8 @@ struct DriverParams {
   double gripper_max_width = 0.0602;   ///< m
   double gripper_min_width = 0.0;      ///< m
   double gripper_default_force = 100;  ///< N, used when a command gives 0
+  double gripper_open_margin = 0.003;  ///< m: plates this near max_width that touch something are open (a
+                                       ///< neighbour), not holding a book, when a (re)started driver takes over
 };
 
 /// What to send to the arm now.

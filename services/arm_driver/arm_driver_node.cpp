@@ -77,6 +77,7 @@ ArmDriverCore make_arm_driver_core(const Config& root) {
   p.gripper_min_width = g.get_double("min_width", 0.0, 0.1);
   p.gripper_max_width = g.get_double("max_width", 0.0, 0.1);
   p.gripper_default_force = g.get_double("default_force_n", 0.0, 1000.0);
+  p.gripper_open_margin = g.get_double("open_margin_m", 0.0, 0.05);
   return ArmDriverCore(std::move(kin), std::move(limits), p);
 }
 

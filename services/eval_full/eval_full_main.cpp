@@ -128,8 +128,9 @@ int main(int argc, char** argv) {
     accumulate(outcome, books, tol, &metrics);
     const FullCycleResult& r = outcome.result;
     const std::string why = failure_reason(r, books);
-    csv << s << "," << r.end << "," << r.books_on_upper_shelf << "," << books_on_lower_shelf(r) << ","
-        << r.grasp_attempts << "," << r.grasp_successes << "," << r.sim_s << "," << r.wall_s << ",\"" << why << "\"\n";
+    const int moved = books_on_lower_shelf(r);
+    csv << s << "," << r.end << "," << r.books_on_upper_shelf << "," << moved << "," << r.grasp_attempts << ","
+        << r.grasp_successes << "," << r.sim_s << "," << r.wall_s << ",\"" << why << "\"\n";
     csv.flush();
     if (!why.empty() || verbose) {
       std::ofstream tr(out + "/trace_seed_" + std::to_string(s) + ".txt");
@@ -142,9 +143,8 @@ int main(int argc, char** argv) {
     if (tty)
       std::cerr << progress_bar(k + 1, scenes, eta, static_cast<int>(metrics.failures.size())) << std::flush;
     else
-      std::cerr << "scene " << (k + 1) << "/" << scenes << " seed " << s << ": " << r.end << ", moved "
-                << books_on_lower_shelf(r) << ", " << r.wall_s << " s wall" << (why.empty() ? "" : " FAILED: " + why)
-                << "\n";
+      std::cerr << "scene " << (k + 1) << "/" << scenes << " seed " << s << ": " << r.end << ", moved " << moved << ", "
+                << r.wall_s << " s wall" << (why.empty() ? "" : " FAILED: " + why) << "\n";
   }
   if (tty) std::cerr << "\n";
   write_report(out, metrics, cmd.str(), books);

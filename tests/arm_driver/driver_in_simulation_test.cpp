@@ -193,5 +193,26 @@ TEST(DriverConfig, NullspacePostureOutsideTheLimitsIsRefused) {
   }
 }
 
+// A negative or missing gripper.open_margin_m is a configuration error naming the key.
+TEST(DriverConfig, GripperOpenMarginOutOfRangeOrMissingIsRefused) {
+  std::ifstream in(kSrc + "/config/services/arm_driver.yaml");
+  std::stringstream ss;
+  ss << in.rdbuf();
+  const std::string text = ss.str();
+  const std::string good = "open_margin_m: 0.003";
+  const auto at = text.find(good);
+  ASSERT_NE(at, std::string::npos) << "arm_driver.yaml changed: update this test";
+  for (const std::string& bad : {std::string("open_margin_m: -0.001"), std::string("")}) {
+    std::string changed = text;
+    changed.replace(at, good.size(), bad);
+    try {
+      make_arm_driver_core(Config::from_string(changed, "arm_driver.yaml"));
+      FAIL() << "no error for '" << bad << "'";
+    } catch (const ConfigError& e) {
+      EXPECT_NE(std::string(e.what()).find("open_margin_m"), std::string::npos) << e.what();
+    }
+  }
+}
+
 }  // namespace
 }  // namespace bookgrasp
