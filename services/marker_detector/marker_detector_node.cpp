@@ -29,6 +29,7 @@ MarkerDetectorSettings MarkerDetectorSettings::from_config(const Config& root) {
   s.cart_max_tilt_rad = root.get_double("tags.cart.max_tilt_deg", 0.0, 180.0) * M_PI / 180.0;
   s.holder_max_tilt_rad = root.get_double("tags.holder.max_tilt_deg", 0.0, 180.0) * M_PI / 180.0;
   s.pose_ambiguity_px = root.get_double("tags.pose_ambiguity_px", 0.0, 100.0);
+  s.stereo_range = TagStereoRangeParams::from_config(root.child("stereo_range"));
   s.report_unassigned = root.get<bool>("tags.report_unassigned");
   s.measure_processing_time = root.get<bool>("diagnostics.measure_processing_time");
   for (int id : s.cart_ids) {
@@ -100,6 +101,27 @@ bool intrinsics_from_calibration(const camera_calibration_t& c, int image_width,
 
 namespace {
 
+/// The image as CV_8UC1; false and a reason if it cannot be decoded or is not an intensity image.
+bool decode_gray(const image_t& msg, cv::Mat* gray, std::string* reason) {
+  cv::Mat image;
+  try {
+    image = image_to_mat(msg);
+  } catch (const std::exception& e) {
+    *reason = std::string("image cannot be decoded: ") + e.what();
+    return false;
+  }
+  if (image.type() == CV_8UC1) {
+    *gray = image;
+  } else if (image.type() == CV_8UC3) {
+    cv::cvtColor(image, *gray, cv::COLOR_RGB2GRAY);
+  } else {
+    *reason = "image pixel format " + pixel_format_name(msg.pixel_format) +
+              " is not an intensity image (send GRAY8, RGB8, PNG or JPEG)";
+    return false;
+  }
+  return true;
+}
+
 std::map<int, std::string> roles_of_ids(const MarkerDetectorSettings& s) {
   std::map<int, std::string> roles;
   for (int id : s.cart_ids) roles[id] = "cart";
@@ -125,21 +147,9 @@ MarkerDetectorNode::MarkerDetectorNode(const MarkerDetectorSettings& settings)
 
 bool MarkerDetectorNode::process(const stereo_frame_t& frame, marker_detections_t* out, std::string* reason) {
   const auto start = std::chrono::steady_clock::now();
-  cv::Mat image;
-  try {
-    image = image_to_mat(frame.left);
-  } catch (const std::exception& e) {
-    *reason = std::string("left image cannot be decoded: ") + e.what();
-    return false;
-  }
   cv::Mat gray;
-  if (image.type() == CV_8UC1) {
-    gray = image;
-  } else if (image.type() == CV_8UC3) {
-    cv::cvtColor(image, gray, cv::COLOR_RGB2GRAY);
-  } else {
-    *reason = "left image pixel format " + pixel_format_name(frame.left.pixel_format) +
-              " is not an intensity image (send GRAY8, RGB8, PNG or JPEG)";
+  if (!decode_gray(frame.left, &gray, reason)) {
+    *reason = "left " + *reason;
     return false;
   }
   TagCameraIntrinsics k;
@@ -162,6 +172,7 @@ bool MarkerDetectorNode::process(const stereo_frame_t& frame, marker_detections_
   out->implementation = implementation();
   out->camera_frame = camera_frame;
   out->markers.clear();
+  cv::Mat right_gray;  // decoded when the first tag needs it
   for (const TagDetection& d : detections) {
     const auto role_it = role_of_id_.find(d.id);
     const std::string role = role_it == role_of_id_.end() ? "" : role_it->second;
@@ -192,6 +203,7 @@ bool MarkerDetectorNode::process(const stereo_frame_t& frame, marker_detections_
         }
         pose = *upright;
       }
+      if (settings_.stereo_range.enabled) range_in_stereo(frame, gray, k, d, role, &right_gray, &pose);
     } catch (const std::exception& e) {
       report_error("tag " + std::to_string(d.id) + ": " + e.what());
       continue;
@@ -220,6 +232,34 @@ bool MarkerDetectorNode::process(const stereo_frame_t& frame, marker_detections_
                            ? std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count()
                            : 0.0;
   return true;
+}
+
+void MarkerDetectorNode::range_in_stereo(const stereo_frame_t& frame, const cv::Mat& left_gray,
+                                         const TagCameraIntrinsics& k, const TagDetection& d, const std::string& role,
+                                         cv::Mat* right_gray, TagPose* pose) {
+  const std::string what = (role.empty() ? std::string("tag ") : role + " tag ") + std::to_string(d.id);
+  if (right_gray->empty()) {
+    std::string why;
+    if (!decode_gray(frame.right, right_gray, &why)) {
+      report_error(what + ": no stereo range, right " + why + " (monocular pose)");
+      return;
+    }
+  }
+  const TagStereoRange r = range_tag_in_stereo(left_gray, *right_gray, d.corners, k.fx, k.cx,
+                                               frame.right_calibration.cx, frame.baseline_m, settings_.stereo_range);
+  if (!r.ok) {
+    report_error(what + ": no stereo range: " + r.reason + " (monocular pose)");
+    return;
+  }
+  const double mono = pose->tag_in_camera.translation().z();
+  if (!(std::abs(r.depth_m - mono) <= settings_.stereo_range.max_disagreement * mono)) {
+    char b[200];
+    std::snprintf(b, sizeof b, "%s: stereo range %.3f m and monocular %.3f m disagree beyond %.0f %% (monocular pose)",
+                  what.c_str(), r.depth_m, mono, settings_.stereo_range.max_disagreement * 100);
+    report_error(b);
+    return;
+  }
+  pose->tag_in_camera = tag_pose_at_depth(pose->tag_in_camera, r.depth_m);
 }
 
 void MarkerDetectorNode::on_stereo(const stereo_frame_t& frame) {

@@ -1,7 +1,7 @@
 #pragma once
 /// @file
 /// The marker_detector component: STEREO_IMAGES (left image + left
-/// calibration) -> MARKERS (every tag with its pose in the camera and in
+/// calibration; the right image for each tag's depth) -> MARKERS (every tag with its pose in the camera and in
 /// `base`, and the role of the cart and holder markers).
 
 #include <map>
@@ -15,6 +15,7 @@
 #include "services/marker_detector/tag_detector.h"
 #include "services/marker_detector/tag_pose.h"
 #include "services/marker_detector/tag_search.h"
+#include "services/marker_detector/tag_stereo_range.h"
 
 namespace bookgrasp {
 
@@ -36,6 +37,7 @@ struct MarkerDetectorSettings {
   double pose_ambiguity_px = 0;         ///< tags.pose_ambiguity_px: IPPE solutions this close in error are both
                                         ///< considered for an upright (cart, holder) tag
   bool report_unassigned = true;        ///< tags.report_unassigned: publish tags whose id has no role
+  TagStereoRangeParams stereo_range;    ///< stereo_range.*: each tag's depth from its disparity in the right image
   bool measure_processing_time = true;  ///< diagnostics.measure_processing_time (wall time in processing_ms)
 
   /// Reads the whole configuration root (channels, apriltag, tags,
@@ -65,6 +67,10 @@ class MarkerDetectorNode : public Component {
 
  private:
   void on_stereo(const stereo_frame_t& frame);
+  /// Slides `pose` to the tag's stereo depth (the right image decoded into `right_gray` once per frame); on any
+  /// problem keeps the monocular pose and says why in the status.
+  void range_in_stereo(const stereo_frame_t& frame, const cv::Mat& left_gray, const TagCameraIntrinsics& k,
+                       const TagDetection& d, const std::string& role, cv::Mat* right_gray, TagPose* pose);
 
   MarkerDetectorSettings settings_;
   std::map<int, std::string> role_of_id_;

@@ -270,6 +270,7 @@ TEST(MarkerDetectorConfig, SharedIdIsRefusedNamingTheKey) {
       "tracking: {enabled: true, roi_margin: 1.0, roi_min_px: 64, full_search_period_s: 1.0}\n"
       "tags: {default_size_m: 0.08, report_unassigned: true, cart: {ids: [0, 2], size_m: 0.08, max_tilt_deg: 20},"
       " holder: {ids: [2], size_m: 0.08, max_tilt_deg: 35}, pose_ambiguity_px: 1.0}\n"
+      "stereo_range: {enabled: true, margin: 0.25, min_depth_m: 0.3, min_score: 0.8, max_disagreement: 0.15}\n"
       "diagnostics: {measure_processing_time: false}\n";
   try {
     MarkerDetectorSettings::from_config(Config::from_string(yaml));
@@ -277,6 +278,35 @@ TEST(MarkerDetectorConfig, SharedIdIsRefusedNamingTheKey) {
   } catch (const ConfigError& e) {
     EXPECT_NE(std::string(e.what()).find("tags.holder.ids"), std::string::npos) << e.what();
   }
+}
+
+TEST(MarkerDetectorConfig, AMissingOrBadStereoRangeKeyIsNamed) {
+  const std::string base =
+      "channels: {input: A, output: B}\n"
+      "apriltag: {family: tag36h11, quad_decimate: 2, quad_sigma: 0, refine_edges: true, decode_sharpening: 0.25,"
+      " threads: 1, max_hamming: 1, min_decision_margin: 20, fallback_quad_sigma: 0}\n"
+      "tracking: {enabled: true, roi_margin: 1.0, roi_min_px: 64, full_search_period_s: 1.0}\n"
+      "tags: {default_size_m: 0.08, report_unassigned: true, cart: {ids: [0], size_m: 0.08, max_tilt_deg: 20},"
+      " holder: {ids: [1], size_m: 0.08, max_tilt_deg: 35}, pose_ambiguity_px: 1.0}\n"
+      "diagnostics: {measure_processing_time: false}\n";
+  const auto error_of = [](const std::string& yaml) -> std::string {
+    try {
+      MarkerDetectorSettings::from_config(Config::from_string(yaml));
+    } catch (const ConfigError& e) {
+      return e.what();
+    }
+    return "";
+  };
+  EXPECT_NE(error_of(base).find("stereo_range"), std::string::npos) << error_of(base);
+  const std::string bad_score =
+      base + "stereo_range: {enabled: true, margin: 0.25, min_depth_m: 0.3, min_score: 1.5, max_disagreement: 0.15}\n";
+  EXPECT_NE(error_of(bad_score).find("stereo_range.min_score"), std::string::npos) << error_of(bad_score);
+  const std::string no_margin =
+      base + "stereo_range: {enabled: true, min_depth_m: 0.3, min_score: 0.8, max_disagreement: 0.15}\n";
+  EXPECT_NE(error_of(no_margin).find("margin"), std::string::npos) << error_of(no_margin);
+  EXPECT_EQ(error_of(base + "stereo_range: {enabled: false, margin: 0.25, min_depth_m: 0.3, min_score: 0.8,"
+                            " max_disagreement: 0.15}\n"),
+            "");
 }
 
 }  // namespace

@@ -3,6 +3,9 @@
 // and where the truth puts it.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cstdio>
+
 #include "common/image_conversion.h"
 #include "common/pose_conversion.h"
 #include "common/sim_render/sim_camera_rig.h"
@@ -58,6 +61,51 @@ TEST(MarkerRenderedScene, TheFallbackPassFindsTheCartTagTheFirstPassMisses) {
   const Eigen::Isometry3d found = pose_to_isometry(m->pose_in_base);
   EXPECT_LT(Eigen::AngleAxisd(found.linear().transpose() * truth.linear()).angle(), 3.0 * M_PI / 180.0);
   EXPECT_LT((found.translation() - truth.translation()).norm(), 0.02);
+}
+
+// Both images of far_cart.yaml's scene `seed`, as the stereo camera publishes them.
+Rendered render_pair(uint64_t seed) {
+  sim_render::SimCameraRig rig(std::string(BOOKGRASP_SOURCE_DIR) + "/config/scenes/far_cart.yaml", seed);
+  const sim_render::CameraImage left = rig.capture("stereo_left", 1000000);
+  const sim_render::CameraImage right = rig.capture("stereo_right", 1000000);
+  Rendered r;
+  r.frame.utime = 1000000;
+  r.frame.left = mat_to_image(left.rgb, image_t::RGB8, 1000000, left.camera.frame);
+  r.frame.right = mat_to_image(right.rgb, image_t::RGB8, 1000000, right.camera.frame);
+  r.frame.left_calibration = left.camera.to_message(1000000);
+  r.frame.right_calibration = right.camera.to_message(1000000);
+  r.frame.baseline_m = (left.camera.camera_in_base.translation() - right.camera.camera_in_base.translation()).norm();
+  r.truth = rig.model().ground_truth(1000000);
+  return r;
+}
+
+// The cart tag is ~30 px at 1.6 m: its monocular pose is a few cm off along the view (far_cart seed 1: 21 mm,
+// which every grasp point inherited through the cart frame, docs/EVALUATION.md). Ranged by its disparity it is
+// within 8 mm of the truth in every scene; the monocular errors are printed for comparison.
+TEST(MarkerRenderedScene, TheStereoRangedCartTagIsWithinEightMillimetresOfTheTruth) {
+  const MarkerDetectorSettings shipped = MarkerDetectorSettings::from_config(
+      Config::load_file(std::string(BOOKGRASP_SOURCE_DIR) + "/config/services/marker_detector.yaml"));
+  ASSERT_TRUE(shipped.stereo_range.enabled);
+  MarkerDetectorSettings mono = shipped;
+  mono.stereo_range.enabled = false;
+  int found = 0;
+  double worst_mono = 0, worst_stereo = 0;
+  for (uint64_t seed = 1; seed <= 6; ++seed) {
+    const Rendered r = render_pair(seed);
+    const std::optional<marker_t> s = cart_marker(shipped, r.frame), m = cart_marker(mono, r.frame);
+    if (!s || !m) continue;  // the tag is not found in every rendered scene (TheFallbackPass... above)
+    ++found;
+    const Eigen::Vector3d truth = pose_to_isometry(r.truth.cart_marker).translation();
+    const double es = (pose_to_isometry(s->pose_in_base).translation() - truth).norm();
+    const double em = (pose_to_isometry(m->pose_in_base).translation() - truth).norm();
+    std::printf("far_cart seed %d: cart tag %.1f mm off with the stereo range, %.1f mm monocular\n",
+                static_cast<int>(seed), es * 1e3, em * 1e3);
+    EXPECT_LT(es, 0.008) << "seed " << seed << " (monocular: " << em * 1e3 << " mm)";
+    worst_mono = std::max(worst_mono, em);
+    worst_stereo = std::max(worst_stereo, es);
+  }
+  EXPECT_GE(found, 4) << "the cart tag was found in too few scenes to judge";
+  EXPECT_LT(worst_stereo, worst_mono) << "the stereo range did not improve on the monocular pose";
 }
 
 // The next frames (same view, 10 Hz) are searched only in regions around the tags found: the cart tag,

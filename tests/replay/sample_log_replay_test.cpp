@@ -54,9 +54,11 @@ TEST_P(SampleReplay, ShippedConfigReproducesTheRecordingBitForBit) {
   }
 }
 
+// The arbiter is replayed on logs/samples/arbiter_seed5.lcm (ArbiterReplay below, > 10 decisions): 20 s of the
+// deployed system on far_cart.yaml (the sample, re-recorded 2026-12-02 for the stereo-ranged markers) end inside the
+// first stripe servo, with one or two arbiter decisions, too few to judge by.
 INSTANTIATE_TEST_SUITE_P(Services, SampleReplay,
-                         testing::Values("marker_detector", "bws_detector", "bwh_detector", "bswh_detector",
-                                         "arbiter"));
+                         testing::Values("marker_detector", "bws_detector", "bwh_detector", "bswh_detector"));
 
 // Chain mode from the cameras' output: marker_detector recomputes MARKERS in the same process and
 // bws_detector pairs each frame with the MARKERS of its utime, so although the two now arrive in
