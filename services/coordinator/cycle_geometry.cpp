@@ -49,6 +49,7 @@ CycleGeometry CycleGeometry::from_config(const Config& c) {
   g.holder_pre_place_offset = vec3(c, "holder.pre_place_offset_m", 1.0);
   g.holder_place_descent = c.get_double("holder.place_descent_m", 0.0, 0.5);
   g.holder_retreat = c.get_double("holder.retreat_m", 0.02, 0.6);
+  g.holder_regrasp_lower = c.get_double("holder.regrasp_lower_m", 0.0, 0.03);
   g.lower_drop = c.get_double("lower_shelf.drop_m", 0.1, 1.5);
   g.lower_front_z = c.get_double("lower_shelf.front_z_m", -0.2, 0.5);
   g.lower_first_right_y = c.get_double("lower_shelf.first_right_y_m", -3, 3);
@@ -109,6 +110,14 @@ Eigen::Isometry3d pre_grasp_pose(const Eigen::Isometry3d& gp, const CycleGeometr
 
 double tcp_height_on_book(const Eigen::Vector3d& gp_grasp, const CycleGeometry& g) {
   return gp_grasp.x() + g.grasp_offset_x;
+}
+
+double holder_regrasp_height(double tcp_height, const CycleGeometry& g) {
+  return tcp_height - g.holder_regrasp_lower;
+}
+
+double height_held_from_holder(double tcp_height, const CycleGeometry& g) {
+  return holder_regrasp_height(tcp_height, g) + g.place_clearance;
 }
 
 Eigen::Isometry3d holder_place_pose(const Eigen::Isometry3d& s, double h, const CycleGeometry& g) {

@@ -44,6 +44,7 @@ struct CycleGeometry {
   Eigen::Vector3d holder_pre_place_offset = Eigen::Vector3d::Zero();  ///< pre-place = place + this (support)
   double holder_place_descent = 0.0;  ///< > 0: the place ends straight down the support's z from this far above
   double holder_retreat = 0.10;     ///< after release, out along the gripper -z
+  double holder_regrasp_lower = 0.0;  ///< the grasp from the holder puts the TCP this much lower on the book
   // lower shelf
   double lower_drop = 0.35;         ///< lower shelf surface below the upper one
   double lower_front_z = 0.01;      ///< fore-edges' plane on the lower shelf, grasp Z
@@ -76,6 +77,12 @@ Eigen::Isometry3d grasp_pose(const Eigen::Isometry3d& gp_base, const CycleGeomet
 Eigen::Isometry3d pre_grasp_pose(const Eigen::Isometry3d& gp_base, const CycleGeometry& g);
 /// Book height above its support at the TCP: GP.x (top above the upper shelf) plus the X offset.
 double tcp_height_on_book(const Eigen::Vector3d& gp_grasp, const CycleGeometry& g);
+/// TCP height above the book's bottom for the grasp from the holder: `tcp_height` (the grasp from the shelf)
+/// less `holder_regrasp_lower`; the holder poses take it as their `tcp_height`.
+double holder_regrasp_height(double tcp_height, const CycleGeometry& g);
+/// TCP height above the book's bottom once it is in the plates after the grasp from the holder: the book
+/// stood on the ledge, `place_clearance` below where it was released (what the lower-shelf poses take).
+double height_held_from_holder(double tcp_height, const CycleGeometry& g);
 /// TCP pose that puts the held book on the holder's ledge.
 Eigen::Isometry3d holder_place_pose(const Eigen::Isometry3d& support, double tcp_height, const CycleGeometry& g);
 /// Pre-place pose on the holder.

@@ -693,7 +693,7 @@ void LibraryCycle::enter(CycleState s) {
       start_linear(holder_place_moves(holder_frame(), tcp_height(), g));
       break;
     case CycleState::kApproachHolder:
-      start_linear({holder_place_pose(holder_frame(), tcp_height(), g)});
+      start_linear({holder_place_pose(holder_frame(), holder_regrasp_height(tcp_height(), g), g)});
       break;
     case CycleState::kRetreatFromHolder:
       start_linear({move_along_own_axes(arm_->end_effector, Eigen::Vector3d(0, 0, -g.holder_retreat))});
@@ -704,12 +704,13 @@ void LibraryCycle::enter(CycleState s) {
       message_ = "book " + std::to_string(progress_.books_moved) + " on the holder: waiting for the user's \"done\"";
       break;
     case CycleState::kMoveToHolderPreGrasp:
-      start_planned_pose(move_along_own_axes(holder_place_pose(holder_frame(), tcp_height(), g),
-                                             Eigen::Vector3d(0, 0, -g.holder_retreat)),
-                         false);
+      start_planned_pose(
+          move_along_own_axes(holder_place_pose(holder_frame(), holder_regrasp_height(tcp_height(), g), g),
+                              Eigen::Vector3d(0, 0, -g.holder_retreat)),
+          false);
       break;
     case CycleState::kLiftFromHolder:
-      start_linear(holder_lift_moves(holder_frame(), tcp_height(), g));
+      start_linear(holder_lift_moves(holder_frame(), holder_regrasp_height(tcp_height(), g), g));
       break;
     case CycleState::kMoveToLowerShelf: {
       const double left_after = progress_.lower_next_right_y - progress_.book_width;
@@ -719,14 +720,14 @@ void LibraryCycle::enter(CycleState s) {
               " (it stays in the gripper)");
         return;
       }
-      start_planned_pose(
-          lower_pre_place_pose(cart_frame(), progress_.lower_next_right_y, progress_.book_width, tcp_height(), g),
-          true);
+      start_planned_pose(lower_pre_place_pose(cart_frame(), progress_.lower_next_right_y, progress_.book_width,
+                                              height_held_from_holder(tcp_height(), g), g),
+                         true);
       break;
     }
     case CycleState::kPlaceOnLowerShelf:
-      start_linear(
-          {lower_place_pose(cart_frame(), progress_.lower_next_right_y, progress_.book_width, tcp_height(), g)});
+      start_linear({lower_place_pose(cart_frame(), progress_.lower_next_right_y, progress_.book_width,
+                                     height_held_from_holder(tcp_height(), g), g)});
       break;
     case CycleState::kRetreatFromLowerShelf:
       start_linear({move_along_own_axes(arm_->end_effector, Eigen::Vector3d(0, 0, -g.lower_retreat))});

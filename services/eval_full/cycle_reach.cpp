@@ -67,8 +67,10 @@ std::vector<StageReach> cycle_reach(const scene::Scene& scene, const CycleGeomet
   const Eigen::Isometry3d hp = holder_place_pose(support, h, g);
   poses.emplace_back("holder_place", hp);
   poses.emplace_back("holder_retreat", move_along_own_axes(hp, Eigen::Vector3d(0, 0, -g.holder_retreat)));
-  poses.emplace_back("lower_pre_place", lower_pre_place_pose(grasp, g.lower_first_right_y, book.width_m, h, g));
-  const Eigen::Isometry3d lp = lower_place_pose(grasp, g.lower_first_right_y, book.width_m, h, g);
+  poses.emplace_back("holder_regrasp", holder_place_pose(support, holder_regrasp_height(h, g), g));
+  const double held = height_held_from_holder(h, g);
+  poses.emplace_back("lower_pre_place", lower_pre_place_pose(grasp, g.lower_first_right_y, book.width_m, held, g));
+  const Eigen::Isometry3d lp = lower_place_pose(grasp, g.lower_first_right_y, book.width_m, held, g);
   poses.emplace_back("lower_place", lp);
   poses.emplace_back("lower_retreat", move_along_own_axes(lp, Eigen::Vector3d(0, 0, -g.lower_retreat)));
 

@@ -39,7 +39,7 @@ Eigen::Isometry3d true_grasp_frame(const scene::Scene& scene);
 /// Every stage pose of the first book's cycle (the scene's right-most book, first place on the
 /// lower shelf) from the scene's truth and `g`, each checked with `ik` from `seed_q`:
 /// stripe_start, stripe_end, bwh_start, pre_grasp, grasp, extract_lift, extract_end,
-/// holder_pre_place, holder_place, holder_retreat, lower_pre_place, lower_place, lower_retreat.
+/// holder_pre_place, holder_place, holder_retreat, holder_regrasp, lower_pre_place, lower_place, lower_retreat.
 /// Throws std::runtime_error if the scene has no book.
 std::vector<StageReach> cycle_reach(const scene::Scene& scene, const CycleGeometry& g, const InverseKinematics& ik,
                                     const Eigen::VectorXd& seed_q);

@@ -84,6 +84,7 @@ class FakeLibrary {
   std::optional<FakeBook> on_holder;
   std::vector<std::pair<FakeBook, Eigen::Isometry3d>> lower;       ///< book, TCP at release
   std::vector<std::pair<FakeBook, Eigen::Isometry3d>> holder_drops;  ///< book, TCP at release on the holder
+  std::vector<std::pair<FakeBook, Eigen::Isometry3d>> holder_grasps;  ///< book, TCP at the grasp from the holder
   Eigen::Isometry3d ee = Eigen::Isometry3d::Identity();
   Eigen::Isometry3d park_pose;
   double width = 0.06;
@@ -275,6 +276,7 @@ class FakeLibrary {
             contact = true;
             ps = Eigen::Vector3d(0.10, in_gripper->right_y - in_gripper->width, -0.10);  // PS.y = GP.y - BW
           } else if (state == "GRASP_FROM_HOLDER" && on_holder) {
+            holder_grasps.emplace_back(*on_holder, ee);
             in_gripper = on_holder;
             on_holder.reset();
             width = in_gripper->width;

@@ -117,14 +117,26 @@ TEST(LibraryCycle, ThreeBooksWholeCycleEveryTransitionAndPlacements) {
 
   // Lower shelf (coordinator.yaml lower_shelf: first_right_y 0.20, gap 0.005, front_z -0.03, drop 0.32): right covers
   // at 0.20, 0.20 - 0.025 - 0.005 = 0.17, 0.17 - 0.020 - 0.005 = 0.145; TCP Y = right - BW/2;
-  // X = -0.32 + height + 0.005; Z = -0.03 + 0.03 (insertion) = 0. Base = (0.60 + Z, -0.05 - Y, X).
+  // Z = -0.03 + 0.03 (insertion) = 0. Base = (0.60 + Z, -0.05 - Y, X). X: the book was taken from the holder
+  // with the TCP holder.regrasp_lower_m (0.015) lower than at its release, after it had dropped place_clearance_m
+  // (0.005) onto the ledge, so the TCP is height - 0.015 + 0.005 above its bottom; the place leaves 0.005 below it:
+  // X = -0.32 + (height - 0.015 + 0.005) + 0.005.
   const double ys[3] = {0.20 - 0.0125, 0.17 - 0.010, 0.145 - 0.015};
   const double hs[3] = {0.25, 0.18, 0.22};
   for (int i = 0; i < 3; ++i) {
     const Eigen::Vector3d tcp = w.lower[i].second.translation();
     EXPECT_NEAR(tcp.x(), 0.60, 0.0015) << "book " << i;
     EXPECT_NEAR(tcp.y(), -0.05 - ys[i], 0.0015) << "book " << i;
-    EXPECT_NEAR(tcp.z(), -0.32 + hs[i] + 0.005, 0.0015) << "book " << i;
+    EXPECT_NEAR(tcp.z(), -0.32 + hs[i] - 0.015 + 0.005 + 0.005, 0.0015) << "book " << i;
+  }
+  // The grasp from the holder: over the place in x and y, 0.015 lower (the TCP at release was height + 0.005 above
+  // the ledge, support z = base z, ledge at -0.09).
+  ASSERT_EQ(w.holder_grasps.size(), 3u);
+  for (int i = 0; i < 3; ++i) {
+    const Eigen::Vector3d drop = w.holder_drops[i].second.translation(), take = w.holder_grasps[i].second.translation();
+    EXPECT_NEAR(take.x(), drop.x(), 0.0015) << "book " << i;
+    EXPECT_NEAR(take.y(), drop.y(), 0.0015) << "book " << i;
+    EXPECT_NEAR(take.z(), -0.09 + hs[i] + 0.005 - 0.015, 0.0015) << "book " << i;
   }
   // Holder: support origin (0.301, 0.28, -0.09), base axes; TCP (-0.02, -0.24, h + 0.005) in it (coordinator.yaml
   // holder.place_tcp_in_support_m: the fingers beyond the back plate's right edge).
@@ -144,7 +156,10 @@ TEST(LibraryCycle, ThreeBooksWholeCycleEveryTransitionAndPlacements) {
   // A diagonal move from the pre-place pose drove a book hanging a little out of square in the plates into
   // the holder's base in front of the ledge's lip (docs/EVALUATION.md, failure mode 4).
   {
-    const Eigen::Vector3d place = w.holder_drops[0].second.translation();
+    // The lift starts where the grasp from the holder took the book (holder.regrasp_lower_m below the release).
+    ASSERT_FALSE(w.holder_grasps.empty());
+    const Eigen::Vector3d release = w.holder_drops[0].second.translation();
+    const Eigen::Vector3d regrasp = w.holder_grasps[0].second.translation();
     int descending = 0, lifting = 0;
     bool before_release = true;
     double highest_place = -1e9;
@@ -154,6 +169,7 @@ TEST(LibraryCycle, ThreeBooksWholeCycleEveryTransitionAndPlacements) {
       if (lifted && state != "LIFT_FROM_HOLDER") break;
       if (state == "RELEASE_ON_HOLDER") before_release = false;
       if (state != "PLACE_ON_HOLDER" && state != "LIFT_FROM_HOLDER") continue;
+      const Eigen::Vector3d& place = state == "PLACE_ON_HOLDER" ? release : regrasp;
       if (state == "PLACE_ON_HOLDER" && before_release) highest_place = std::max(highest_place, p.z() - place.z());
       if (p.z() < place.z() + 0.095 && (p - place).norm() < 0.2) {
         // Below the descent's top: only over the place (support x and y as at the release).

@@ -77,7 +77,7 @@ TEST(CycleReach, StagesAgreeWithForwardKinematicsAndTheElbowLimit) {
   for (uint64_t seed = 1; seed <= 3; ++seed) {
     const scene::Scene scene = scene::load_scene(kSrc + "/config/scenes/default.yaml", seed);
     const std::vector<StageReach> r = cycle_reach(scene, coordinator_geometry(), ik, park);
-    ASSERT_EQ(r.size(), 13u);
+    ASSERT_EQ(r.size(), 14u);
     EXPECT_EQ(r.front().stage, "stripe_start");
     EXPECT_EQ(r.back().stage, "lower_retreat");
     for (const StageReach& st : r) {
