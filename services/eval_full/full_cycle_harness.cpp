@@ -305,6 +305,18 @@ struct FullCycleHarness::Impl {
                       p.position[1], p.position[2], p.orientation[0], p.orientation[1], p.orientation[2],
                       p.orientation[3]);
         poses += b;
+        // Against the truth: position error in the cart's true grasp axes, rotation error.
+        const ground_truth_t gt = sim->world().model().ground_truth(sim->world().now_utime());
+        const pose_t* truth_pose = k.role == "cart"     ? &gt.cart_marker
+                                   : k.role == "holder" ? &gt.holder_marker
+                                                        : nullptr;
+        if (truth_pose) {
+          const Eigen::Isometry3d det = pose_to_isometry(p), tru = pose_to_isometry(*truth_pose);
+          const Eigen::Vector3d e = (true_grasp(det.translation()) - true_grasp(tru.translation())) * 1e3;
+          const double rot = Eigen::AngleAxisd(tru.linear().transpose() * det.linear()).angle() * 180 / M_PI;
+          poses += fmt(" (truth: off (%.1f ", e.x()) + fmt("%.1f ", e.y()) + fmt("%.1f) mm in grasp axes, ", e.z()) +
+                   fmt("turned %.2f deg);", rot);
+        }
       }
       trace("MARKERS now: [" + roles + "]" + poses);
     }
@@ -494,6 +506,11 @@ struct FullCycleHarness::Impl {
         const Eigen::Vector3d e = (d.gp_grasp - d.p1_true_grasp) * 1e3;
         trace(fmt("TRUTH GP - true corner (%.1f, ", e.x()) + fmt("%.1f, ", e.y()) + fmt("%.1f) mm", e.z()) +
               fmt(", book width %.1f mm", tb->width_m * 1e3));
+        // Where the arm is sent: GP in base (through the arbiter's cart frame) against the true corner, true axes.
+        d.gp_base_true_grasp = true_grasp(pose_to_isometry(m->gp_base).translation());
+        const Eigen::Vector3d eb = (d.gp_base_true_grasp - d.p1_true_grasp) * 1e3;
+        trace(fmt("TRUTH GP in base - true corner (%.1f, ", eb.x()) + fmt("%.1f, ", eb.y()) +
+              fmt("%.1f) mm in the true grasp frame", eb.z()));
       }
       res.decisions.push_back(d);
     } else if (word == "BOOK_WIDTH") {

@@ -61,6 +61,9 @@ struct GraspDecisionRecord {
   Eigen::Vector3d p2_grasp = Eigen::Vector3d::Zero();
   Eigen::Vector3d gp_grasp = Eigen::Vector3d::Zero();
   Eigen::Vector3d p1_true_grasp = Eigen::Vector3d::Zero();  ///< true P1 of the right-most book, same frame
+  /// GP_BASE (where the arm is sent, through the arbiter's cart frame) in the cart's true grasp frame: against
+  /// p1_true_grasp it is the physical error, which gp_grasp (the arbiter's own frame) cannot show.
+  Eigen::Vector3d gp_base_true_grasp = Eigen::Vector3d::Zero();
   bool truth_known = false;
   bool p1_valid = false;             ///< the arbiter used P1 (p1_used)
 };
