@@ -110,6 +110,40 @@ double translation_error(const pose_t& p, const Eigen::Isometry3d& truth) {
   return (pose_to_isometry(p).translation() - truth.translation()).norm();
 }
 
+// The right image drawn as the right camera (0.12 m along the left's +x) sees the tags: each tag's depth comes
+// from its disparity. The right image equal to the left (disparity 0, no pair at all) keeps the monocular poses
+// and says why in the status.
+TEST_F(NodeOnBus, TagsAreRangedInTheRightImageAndAFalsePairKeepsTheMonocularPoses) {
+  Scene s = make_scene(1000000);
+  cv::Mat right(480, 640, CV_8UC1, cv::Scalar(150));
+  apriltag_family_t* fam = tag36h11_create();
+  const Eigen::Translation3d left_to_right(-0.12, 0, 0);
+  test::draw_tag(right, fam, 3, 0.10, left_to_right * s.cart_in_camera, 600, 600, 319.5, 239.5);
+  test::draw_tag(right, fam, 4, 0.06, left_to_right * s.holder_in_camera, 600, 600, 319.5, 239.5);
+  tag36h11_destroy(fam);
+  cv::Mat right_rgb;
+  cv::cvtColor(right, right_rgb, cv::COLOR_GRAY2RGB);
+  const stereo_frame_t same = s.frame;  // right == left
+  s.frame.right = mat_to_image(right_rgb, image_t::RGB8, 1000000, "stereo_right");
+  comp.bus().publish("STEREO_IMAGES", &s.frame);
+  comp.spin();
+  ASSERT_EQ(col.got.size(), 1u);
+  ASSERT_EQ(col.got[0].markers.size(), 2u);
+  EXPECT_EQ(node->last_error(), "");
+  EXPECT_NEAR(pose_to_isometry(col.got[0].markers[0].pose_in_camera).translation().z(), 0.9, 0.9 * 0.005);
+  EXPECT_NEAR(pose_to_isometry(col.got[0].markers[1].pose_in_camera).translation().z(), 0.8, 0.8 * 0.005);
+
+  stereo_frame_t later = same;
+  later.utime = later.left.utime = 1100000;
+  comp.bus().publish("STEREO_IMAGES", &later);
+  comp.spin();
+  ASSERT_EQ(col.got.size(), 2u);
+  ASSERT_EQ(col.got[1].markers.size(), 2u) << "a false pair must not lose the tags";
+  EXPECT_NE(node->last_error().find("not positive"), std::string::npos) << node->last_error();
+  EXPECT_NE(node->last_error().find("monocular pose"), std::string::npos) << node->last_error();
+  EXPECT_LT(translation_error(col.got[1].markers[0].pose_in_camera, s.cart_in_camera), 0.02);
+}
+
 TEST_F(NodeOnBus, PublishesCartAndHolderPosesInCameraAndBase) {
   const Scene s = make_scene(1234567);
   comp.bus().publish("STEREO_IMAGES", &s.frame);
