@@ -1,5 +1,6 @@
 #include "services/coordinator/cycle_geometry.h"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
@@ -31,6 +32,7 @@ CycleGeometry CycleGeometry::from_config(const Config& c) {
   g.stripe_fixed_depth = c.get_double("servo.stripe_fixed_depth_m", 0.02, 1.0);
   g.bwh_start_z = c.get_double("servo.bwh_start_z_m", -1.0, 0.0);
   g.bwh_start_offset_x = c.get_double("servo.bwh_start_offset_x_m", -0.3, 0.3);
+  g.book_front_z = c.get_double("servo.book_front_z_m", -0.2, 0.3);
   g.grasp_offset_x = c.get_double("grasp.offset_x_m", -0.1, 0.1);
   g.grasp_offset_y = c.get_double("grasp.offset_y_m", -0.1, 0.1);
   g.insertion_depth = c.get_double("grasp.insertion_depth_m", 0.0, 0.2);
@@ -60,6 +62,8 @@ CycleGeometry CycleGeometry::from_config(const Config& c) {
                       c.path_of("lower_shelf.left_y_m"));
   g.lower_pre_place_offset = vec3(c, "lower_shelf.pre_place_offset_m", 1.0);
   g.lower_retreat = c.get_double("lower_shelf.retreat_m", 0.02, 1.0);
+  g.lower_shelf_gap = c.get_double("lower_shelf.gap_to_upper_shelf_m", 0.0, 1.5);
+  g.held_top_above_tcp = c.get_double("lower_shelf.held_box_top_above_tcp_m", -0.2, 0.2);
   g.place_clearance = c.get_double("place_clearance_m", 0.0, 0.05);
   return g;
 }
@@ -92,6 +96,10 @@ Eigen::Isometry3d stripe_start_pose(const Eigen::Isometry3d& f, const CycleGeome
 
 Eigen::Isometry3d bwh_start_pose(const Eigen::Isometry3d& f, const Eigen::Vector3d& start, const CycleGeometry& g) {
   return pose_in_grasp_frame(f, Eigen::Vector3d(start.x() + g.bwh_start_offset_x, start.y(), g.bwh_start_z));
+}
+
+double servo_standoff(double front_z, const CycleGeometry& g) {
+  return std::max(0.02, front_z - g.bwh_start_z);
 }
 
 Eigen::Isometry3d move_along_own_axes(const Eigen::Isometry3d& pose, const Eigen::Vector3d& d) {
@@ -156,9 +164,17 @@ Eigen::Isometry3d lower_place_pose(const Eigen::Isometry3d& f, double right_y, d
 }
 
 Eigen::Isometry3d lower_pre_place_pose(const Eigen::Isometry3d& f, double right_y, double bw, double h,
-                                       const CycleGeometry& g) {
+                                       double held_box_height, const CycleGeometry& g) {
   Eigen::Isometry3d p = lower_place_pose(f, right_y, bw, h, g);
-  p.translation() += f.linear() * g.lower_pre_place_offset;
+  Eigen::Vector3d offset = g.lower_pre_place_offset;
+  if (g.lower_shelf_gap > 0) {
+    // TCP height over the place pose that centres the box: box bottom = TCP + top_above - H.
+    const double place_x = -g.lower_drop + h + g.place_clearance;
+    const double centred_x =
+        -g.lower_drop + (g.lower_shelf_gap - held_box_height) / 2 + held_box_height - g.held_top_above_tcp;
+    offset.x() = std::max(offset.x(), centred_x - place_x);
+  }
+  p.translation() += f.linear() * offset;
   return p;
 }
 

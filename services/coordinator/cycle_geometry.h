@@ -30,6 +30,7 @@ struct CycleGeometry {
   double stripe_fixed_depth = 0.2;  ///< distance kept to the rear board during the stripe servo
   double bwh_start_z = -0.15;       ///< fixed Z in front of the cart where BwH starts
   double bwh_start_offset_x = 0.0;  ///< added to the start point's X
+  double book_front_z = 0.01;       ///< grasp Z of the books' fronts when BwS gave no valid P1 (arbiter's alike)
   // grasp
   double grasp_offset_x = 0.0;      ///< TCP below (-) / above (+) GP along X
   double grasp_offset_y = 0.0;      ///< TCP right (+) of GP along Y
@@ -53,6 +54,8 @@ struct CycleGeometry {
   double lower_left_y = -0.40;      ///< inner left end of the lower shelf, grasp Y
   Eigen::Vector3d lower_pre_place_offset = Eigen::Vector3d::Zero();  ///< pre-place = place + this (grasp)
   double lower_retreat = 0.30;      ///< after release, out along -Z
+  double lower_shelf_gap = 0.0;     ///< free height between the lower shelf and the upper one's underside (0 = unused)
+  double held_top_above_tcp = 0.015;  ///< the planner's held-book box: its top above the TCP (planner.yaml)
   double place_clearance = 0.005;   ///< book bottom this far above a support when released
 
   /// Reads the `geometry:` section; throws ConfigError naming a bad key.
@@ -97,9 +100,14 @@ std::vector<Eigen::Isometry3d> holder_lift_moves(const Eigen::Isometry3d& suppor
 /// TCP pose that stands the held book on the lower shelf with its right cover at grasp Y `right_y`.
 Eigen::Isometry3d lower_place_pose(const Eigen::Isometry3d& grasp_frame, double right_y, double book_width,
                                    double tcp_height, const CycleGeometry& g);
-/// Pre-place pose on the lower shelf.
+/// Pre-place pose on the lower shelf: the place pose moved by `lower_pre_place_offset`, raised (if that is
+/// higher) so that the planner's held-book box of height `held_box_height` (its top `held_top_above_tcp` above the
+/// TCP) sits in the middle of the gap between the shelves (`lower_shelf_gap` > 0).
 Eigen::Isometry3d lower_pre_place_pose(const Eigen::Isometry3d& grasp_frame, double right_y, double book_width,
-                                       double tcp_height, const CycleGeometry& g);
+                                       double tcp_height, double held_box_height, const CycleGeometry& g);
+/// The corner servo's standoff (distance from the TCP to the book's front along the approach) for a book front at
+/// grasp Z `front_z`, the TCP held at `bwh_start_z`; at least 2 cm.
+double servo_standoff(double front_z, const CycleGeometry& g);
 /// `pose` moved by `d` along its own axes (x, y, z).
 Eigen::Isometry3d move_along_own_axes(const Eigen::Isometry3d& pose, const Eigen::Vector3d& d);
 

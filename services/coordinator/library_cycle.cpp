@@ -244,6 +244,9 @@ Eigen::Isometry3d LibraryCycle::cart_frame() const {
 Eigen::Isometry3d LibraryCycle::holder_frame() const {
   return holder_support_frame(*holder_marker_, s_.geometry);
 }
+double LibraryCycle::held_box_height() const {
+  return std::max(0.0, progress_.gp_grasp.x());
+}
 double LibraryCycle::tcp_height() const {
   return tcp_height_on_book(progress_.gp_grasp, s_.geometry);
 }
@@ -321,8 +324,7 @@ void LibraryCycle::issue_plan() {
   r.start_joints = arm_->joints;
   motion_.plan_start = arm_->joints;
   r.holding_book = motion_.holding;
-  if (motion_.holding)
-    r.book_size = Eigen::Vector3d(progress_.book_width, std::max(0.0, progress_.gp_grasp.x()), s_.held_book_depth_m);
+  if (motion_.holding) r.book_size = Eigen::Vector3d(progress_.book_width, held_box_height(), s_.held_book_depth_m);
   out_.push_back(r);
 }
 
@@ -648,8 +650,10 @@ void LibraryCycle::enter(CycleState s) {
       r.servo_mode = kServoBookCorner;
       r.pose = arm_ ? arm_->end_effector : bwh_start_pose(cart_frame(), bwh_start_, g);
       r.rank = rank_;
-      r.fixed_depth =
-          -g.bwh_start_z;  // the servo keeps the start's distance to the books (elbow limit nearer the robot)
+      // The servo keeps the start's distance to the books (the elbow's limit nearer the robot) and takes the corner
+      // on the book's front: P1.z when P1 is valid (the fore-edges stand 0-2 cm behind the shelf's edge; with the hand
+      // camera above the TCP a front 1 cm further than assumed put P2 ~6 mm above the true corner).
+      r.fixed_depth = servo_standoff(bwh_front_z_, g);
       r.timeout_s = s_.servo_timeout_s;
       out_.push_back(r);
       early_decision_.reset();
@@ -721,7 +725,7 @@ void LibraryCycle::enter(CycleState s) {
         return;
       }
       start_planned_pose(lower_pre_place_pose(cart_frame(), progress_.lower_next_right_y, progress_.book_width,
-                                              height_held_from_holder(tcp_height(), g), g),
+                                              height_held_from_holder(tcp_height(), g), held_box_height(), g),
                          true);
       break;
     }
@@ -898,6 +902,7 @@ void LibraryCycle::handle_p1_check(const DecisionEvent& d) {
     return;
   }
   bwh_start_ = d.gp_grasp;
+  bwh_front_z_ = d.outcome == "P1_VALID" ? d.gp_grasp.z() : s_.geometry.book_front_z;
   rank_ = 0;
   message_ = d.reason;
   succeed(CycleState::kMoveToBwhStart);
@@ -920,6 +925,7 @@ void LibraryCycle::handle_ps_check(const DecisionEvent& d) {
     return;
   }
   bwh_start_ = d.gp_grasp;
+  bwh_front_z_ = d.outcome == "P1_VALID" ? d.gp_grasp.z() : s_.geometry.book_front_z;
   rank_ = 0;
   message_ = d.reason;
   succeed(CycleState::kMoveToBwhStart);

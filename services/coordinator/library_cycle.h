@@ -299,6 +299,8 @@ class LibraryCycle {
   Eigen::Isometry3d cart_frame() const;
   Eigen::Isometry3d holder_frame() const;
   double tcp_height() const;
+  /// Height of the book the planner is told about while it is held (GP.x).
+  double held_box_height() const;
   void handle_p1_check(const DecisionEvent& d);
   void handle_ps_check(const DecisionEvent& d);
   void handle_grasp_decision(const DecisionEvent& d);
@@ -325,6 +327,8 @@ class LibraryCycle {
   int64_t servo_request_ = -1;
   int rank_ = 0;
   Eigen::Vector3d bwh_start_ = Eigen::Vector3d::Zero();
+  double bwh_front_z_ =
+      0.0;  ///< grasp Z of the book's front for the corner servo: P1.z when P1 is valid, else the model's
   std::optional<DecisionEvent> early_decision_;  ///< a decision that arrived before its servo status
   Eigen::Isometry3d gp_base_ = Eigen::Isometry3d::Identity();
   bool user_event_sent_ = false;

@@ -1,5 +1,6 @@
 #include "services/eval_full/cycle_reach.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -69,7 +70,8 @@ std::vector<StageReach> cycle_reach(const scene::Scene& scene, const CycleGeomet
   poses.emplace_back("holder_retreat", move_along_own_axes(hp, Eigen::Vector3d(0, 0, -g.holder_retreat)));
   poses.emplace_back("holder_regrasp", holder_place_pose(support, holder_regrasp_height(h, g), g));
   const double held = height_held_from_holder(h, g);
-  poses.emplace_back("lower_pre_place", lower_pre_place_pose(grasp, g.lower_first_right_y, book.width_m, held, g));
+  poses.emplace_back("lower_pre_place",
+                     lower_pre_place_pose(grasp, g.lower_first_right_y, book.width_m, held, std::max(0.0, p1.x()), g));
   const Eigen::Isometry3d lp = lower_place_pose(grasp, g.lower_first_right_y, book.width_m, held, g);
   poses.emplace_back("lower_place", lp);
   poses.emplace_back("lower_retreat", move_along_own_axes(lp, Eigen::Vector3d(0, 0, -g.lower_retreat)));

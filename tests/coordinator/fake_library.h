@@ -180,6 +180,7 @@ class FakeLibrary {
     }
   }
 
+  static constexpr double kP1FrontZ = 0.012;  ///< the books' fronts as BwS measures them (P1.z), grasp frame
   bookgrasp::DecisionEvent p1_check(int64_t request_id) const {
     bookgrasp::DecisionEvent d;
     d.utime = t;
@@ -191,7 +192,7 @@ class FakeLibrary {
       d.outcome = "NEED_PS";
     } else if (!upper.empty()) {
       d.outcome = "P1_VALID";
-      d.gp_grasp = Eigen::Vector3d(upper.front().height, upper.front().right_y, 0.01);
+      d.gp_grasp = Eigen::Vector3d(upper.front().height, upper.front().right_y, kP1FrontZ);
     } else {
       d.outcome = "P1_INVALID";
       d.gp_grasp = *ps;

@@ -183,13 +183,14 @@ TEST(LibraryCycle, ThreeBooksWholeCycleEveryTransitionAndPlacements) {
     EXPECT_NEAR(highest_place, 0.10, 0.01) << "the place starts at the descent's height";
   }
 
-  // The book-corner servo keeps the BwH start's distance to the books: fixed depth = -bwh_start_z_m (0.10 in
-  // coordinator.yaml), so it never pulls the TCP towards the robot (the elbow's limit).
+  // The book-corner servo keeps the BwH start's distance to the books (TCP at Z = bwh_start_z_m, -0.10 in
+  // coordinator.yaml), so it never pulls the TCP towards the robot (the elbow's limit), and takes the corner on the
+  // book's front as BwS measured it: standoff = P1.z + 0.10 (the fake's P1.z is 0.012).
   int corner_requests = 0;
   for (const auto& q : w.requests)
     if (q.kind == CycleRequest::Kind::kServo && q.servo_mode == 1) {  // BOOK_CORNER (SERVO_REQUEST mode)
       ++corner_requests;
-      EXPECT_NEAR(q.fixed_depth, 0.10, 1e-12);
+      EXPECT_NEAR(q.fixed_depth, 0.112, 1e-12);
     }
   EXPECT_GE(corner_requests, 3);
 
