@@ -114,7 +114,10 @@ void accumulate(const SceneOutcome& o, int max_books, const MetricTolerances& to
   m->holder_standing += r.holder_standing;
   for (const auto& d : r.decisions) {
     if (d.truth_known)
-      for (int k = 0; k < 3; ++k) m->gp_error_mm[k].push_back((d.gp_grasp[k] - d.p1_true_grasp[k]) * 1e3);
+      for (int k = 0; k < 3; ++k) {
+        m->gp_error_mm[k].push_back((d.gp_grasp[k] - d.p1_true_grasp[k]) * 1e3);
+        m->gp_base_error_mm[k].push_back((d.gp_base_true_grasp[k] - d.p1_true_grasp[k]) * 1e3);
+      }
     if (!d.p1_present) continue;
     ++m->decisions;
     const double dy = d.p2_grasp.y() - d.p1_grasp.y(), dx = d.p2_grasp.x() - d.p1_grasp.x();
@@ -205,6 +208,9 @@ std::string metrics_json(const EvalMetrics& m, const std::string& command) {
   j << "  \"gp_error_mm\": {\"x\": " << signed_stats_json(stats_of(m.gp_error_mm[0]))
     << ", \"y\": " << signed_stats_json(stats_of(m.gp_error_mm[1]))
     << ", \"z\": " << signed_stats_json(stats_of(m.gp_error_mm[2])) << "},\n";
+  j << "  \"gp_base_error_mm\": {\"x\": " << signed_stats_json(stats_of(m.gp_base_error_mm[0]))
+    << ", \"y\": " << signed_stats_json(stats_of(m.gp_base_error_mm[1]))
+    << ", \"z\": " << signed_stats_json(stats_of(m.gp_base_error_mm[2])) << "},\n";
   j << "  \"cycle_s\": " << stats_json(stats_of(m.cycle_s)) << ",\n";
   j << "  \"planning_ms\": " << stats_json(stats_of(m.plan_ms)) << ",\n";
   j << "  \"scene_wall_s\": " << stats_json(stats_of(m.scene_wall_s)) << ",\n";

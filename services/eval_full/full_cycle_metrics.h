@@ -52,6 +52,9 @@ struct EvalMetrics {
   std::vector<double> width_error_mm;        ///< |measured - true| per book
   std::vector<double> p1_error_mm[3];        ///< |P1 - true P1| per grasp-frame axis (X, Y, Z)
   std::vector<double> gp_error_mm[3];        ///< GP - true P1 (signed) per grasp-frame axis, every GRASP decision
+  /// GP_BASE (where the arm is sent) - true P1 in the cart's true grasp frame: the physical error, which
+  /// gp_error_mm (GP in the arbiter's own cart frame) does not show when the cart frame itself is off.
+  std::vector<double> gp_base_error_mm[3];
   std::vector<double> p1_p2_dy_mm, p1_p2_dx_mm;  ///< P2 - P1 per decision
   std::vector<double> cycle_s;               ///< per moved book, message time
   std::vector<double> plan_ms;               ///< planner time per request

@@ -58,6 +58,7 @@ SceneOutcome done_scene(uint64_t seed) {
   d.gp_grasp = {0.20, 0.11, 0.01};
   d.truth_known = true;
   d.p1_true_grasp = {0.204, 0.10, 0.013};
+  d.gp_base_true_grasp = {0.210, 0.11, -0.007};  // the cart frame 10 mm high and 20 mm short
   GraspDecisionRecord e = d;
   e.p2_grasp = {0.20, 0.12, 0.01};  // dY 20 mm: disagree
   e.gp_grasp = {0.20, 0.12, 0.01};
@@ -104,6 +105,9 @@ TEST(FullCycleMetrics, AccumulatesRatesAndErrors) {
   ASSERT_EQ(m.gp_error_mm[1].size(), 2u);
   EXPECT_NEAR(m.gp_error_mm[0][0], -4.0, 1e-9);
   EXPECT_NEAR(m.gp_error_mm[1][1], 20.0, 1e-9);
+  ASSERT_EQ(m.gp_base_error_mm[2].size(), 2u);
+  EXPECT_NEAR(m.gp_base_error_mm[0][0], 6.0, 1e-9);
+  EXPECT_NEAR(m.gp_base_error_mm[2][1], -20.0, 1e-9);
   ASSERT_EQ(m.cycle_s.size(), 2u);
   EXPECT_DOUBLE_EQ(m.cycle_s[1], 120);
   // A retried grasp is a failure mode of its own, listed with the seed.
