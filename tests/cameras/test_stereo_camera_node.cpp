@@ -117,6 +117,7 @@ struct Collector {
 TEST(StereoCameraSim, RendersAtTheFrameRateInSimTimeAndRejectsBadStates) {
   StereoCameraSettings s = default_settings("sim");
   s.seed = 2;
+  s.sim_frame_rate_hz = 10;  // the rate mechanism at 10 Hz (the shipped rate is 2)
   // The simulation's own model of the same scene and seed gives the states.
   scene::SimModel sim = scene::SimModel::build(scene::load_scene(s.scene_file, 2));
   Composition comp;
