@@ -901,6 +901,10 @@ void LibraryCycle::handle_p1_check(const DecisionEvent& d) {
     succeed(CycleState::kMoveToStripeStart);
     return;
   }
+  start_bwh_from(d);
+}
+
+void LibraryCycle::start_bwh_from(const DecisionEvent& d) {
   bwh_start_ = d.gp_grasp;
   bwh_front_z_ = d.outcome == "P1_VALID" ? d.gp_grasp.z() : s_.geometry.book_front_z;
   rank_ = 0;
@@ -924,11 +928,7 @@ void LibraryCycle::handle_ps_check(const DecisionEvent& d) {
     fail("unexpected arbiter answer after the stripe servo: " + d.reason);
     return;
   }
-  bwh_start_ = d.gp_grasp;
-  bwh_front_z_ = d.outcome == "P1_VALID" ? d.gp_grasp.z() : s_.geometry.book_front_z;
-  rank_ = 0;
-  message_ = d.reason;
-  succeed(CycleState::kMoveToBwhStart);
+  start_bwh_from(d);
 }
 
 void LibraryCycle::handle_grasp_decision(const DecisionEvent& d) {

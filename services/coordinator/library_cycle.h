@@ -301,6 +301,8 @@ class LibraryCycle {
   double tcp_height() const;
   /// Height of the book the planner is told about while it is held (GP.x).
   double held_box_height() const;
+  /// BwH from the P1 check's or PS check's answer: its start point (P1 or PS) and the book front's Z.
+  void start_bwh_from(const DecisionEvent& d);
   void handle_p1_check(const DecisionEvent& d);
   void handle_ps_check(const DecisionEvent& d);
   void handle_grasp_decision(const DecisionEvent& d);
