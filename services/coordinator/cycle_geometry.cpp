@@ -102,6 +102,20 @@ double servo_standoff(double front_z, const CycleGeometry& g) {
   return std::max(0.02, front_z - g.bwh_start_z);
 }
 
+std::vector<Eigen::Isometry3d> extract_moves(const Eigen::Isometry3d& here, const Eigen::Isometry3d& grasp_frame,
+                                             double tcp_height, double grasp_tcp_z, const CycleGeometry& g) {
+  const Eigen::Isometry3d to_grasp = grasp_frame.inverse();
+  // How far one metre along the gripper's own axis moves the TCP along the grasp axis (books lean a few
+  // degrees, so about 1; never below 0.5, so a strange posture cannot make the move run away).
+  const auto along = [&](const Eigen::Isometry3d& pose, int axis) {
+    return std::max(0.5, std::abs((to_grasp.linear() * pose.linear().col(axis))(axis)));
+  };
+  const double up = tcp_height + g.extract_lift - (to_grasp * here.translation()).x();
+  const Eigen::Isometry3d lifted = move_along_own_axes(here, Eigen::Vector3d(std::max(0.0, up) / along(here, 0), 0, 0));
+  const double out = (to_grasp * lifted.translation()).z() - (grasp_tcp_z - g.extract_retreat);
+  return {lifted, move_along_own_axes(lifted, Eigen::Vector3d(0, 0, -std::max(0.0, out) / along(lifted, 2)))};
+}
+
 Eigen::Isometry3d move_along_own_axes(const Eigen::Isometry3d& pose, const Eigen::Vector3d& d) {
   Eigen::Isometry3d t = pose;
   t.translation() += pose.linear() * d;

@@ -108,6 +108,14 @@ Eigen::Isometry3d lower_pre_place_pose(const Eigen::Isometry3d& grasp_frame, dou
 /// The corner servo's standoff (distance from the TCP to the book's front along the approach) for a book front at
 /// grasp Z `front_z`, the TCP held at `bwh_start_z`; at least 2 cm.
 double servo_standoff(double front_z, const CycleGeometry& g);
+/// The two straight moves of EXTRACT from the TCP pose `here`: up along the gripper's own x until the TCP is
+/// `extract_lift` above `tcp_height` (its height on the book, grasp X), then out along its own -z until it is
+/// `extract_retreat` in front of `grasp_tcp_z` (the TCP's grasp Z at the grasp). The targets are absolute in the
+/// grasp frame `grasp_frame`, so an EXTRACT resumed or retried part-way ends where the first would have (a lift
+/// relative to `here` took a resumed coordinator's arm 0.34 m beyond it, into a joint limit). Neither move goes
+/// back: a TCP already higher or further out stays there.
+std::vector<Eigen::Isometry3d> extract_moves(const Eigen::Isometry3d& here, const Eigen::Isometry3d& grasp_frame,
+                                             double tcp_height, double grasp_tcp_z, const CycleGeometry& g);
 /// `pose` moved by `d` along its own axes (x, y, z).
 Eigen::Isometry3d move_along_own_axes(const Eigen::Isometry3d& pose, const Eigen::Vector3d& d);
 

@@ -685,9 +685,8 @@ void LibraryCycle::enter(CycleState s) {
       start_gripper(true);
       break;
     case CycleState::kExtract: {
-      const Eigen::Isometry3d here = arm_->end_effector;
-      const Eigen::Isometry3d lifted = move_along_own_axes(here, Eigen::Vector3d(g.extract_lift, 0, 0));
-      start_linear({lifted, move_along_own_axes(lifted, Eigen::Vector3d(0, 0, -g.extract_retreat))});
+      start_linear(
+          extract_moves(arm_->end_effector, cart_frame(), tcp_height(), progress_.gp_grasp.z() + g.insertion_depth, g));
       break;
     }
     case CycleState::kMoveToHolder:

@@ -4,6 +4,8 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 namespace bookgrasp {
 namespace {
 
@@ -54,6 +56,41 @@ TEST(CycleGeometry, TheLowerPrePlaceCentresTheHeldBookBetweenTheShelves) {
   const Eigen::Isometry3d p0 = lower_place_pose(f, 0.2, 0.02, 0.19, plain);
   const Eigen::Isometry3d q0 = lower_pre_place_pose(f, 0.2, 0.02, 0.19, 0.20, plain);
   EXPECT_NEAR(q0.translation().x() - p0.translation().x(), 0.01, 1e-12);
+}
+
+TEST(CycleGeometry, ExtractEndsAtTheSameHeightAndDepthWhereverItStarts) {
+  CycleGeometry g = geometry();
+  g.extract_lift = 0.34;
+  g.extract_retreat = 0.02;
+  // The grasp frame: X = base z, Y = -base y, Z = base x (as the default cart), origin (0.6, -0.05, 0).
+  Eigen::Isometry3d f = Eigen::Isometry3d::Identity();
+  f.linear().col(0) = Eigen::Vector3d(0, 0, 1);
+  f.linear().col(1) = Eigen::Vector3d(0, -1, 0);
+  f.linear().col(2) = Eigen::Vector3d(1, 0, 0);
+  f.translation() = Eigen::Vector3d(0.6, -0.05, 0.0);
+  const double tcp_height = 0.20, grasp_z = 0.04;  // TCP at grasp X 0.20, Z 0.04 when it closed
+  Eigen::Isometry3d at_grasp = f;
+  at_grasp.translation() = f * Eigen::Vector3d(tcp_height, 0.1, grasp_z);
+  const auto first = extract_moves(at_grasp, f, tcp_height, grasp_z, g);
+  ASSERT_EQ(first.size(), 2u);
+  const Eigen::Vector3d lifted = f.inverse() * first[0].translation(), out = f.inverse() * first[1].translation();
+  EXPECT_NEAR(lifted.x(), 0.54, 1e-12);  // 0.20 + 0.34
+  EXPECT_NEAR(lifted.z(), 0.04, 1e-12);
+  EXPECT_NEAR(out.x(), 0.54, 1e-12);
+  EXPECT_NEAR(out.z(), 0.02, 1e-12);  // 2 cm out
+  // Resumed half-way up (0.37), or after the lift and part of the retreat: the same end, nothing beyond it.
+  Eigen::Isometry3d half = at_grasp;
+  half.translation() = f * Eigen::Vector3d(0.37, 0.1, grasp_z);
+  EXPECT_TRUE(extract_moves(half, f, tcp_height, grasp_z, g)[1].translation().isApprox(first[1].translation(), 1e-12));
+  Eigen::Isometry3d part_out = at_grasp;
+  part_out.translation() = f * Eigen::Vector3d(0.54, 0.1, 0.03);
+  const auto again = extract_moves(part_out, f, tcp_height, grasp_z, g);
+  EXPECT_TRUE(again[0].translation().isApprox(part_out.translation(), 1e-12));  // no further lift
+  EXPECT_TRUE(again[1].translation().isApprox(first[1].translation(), 1e-12));
+  // A gripper tilted 10 deg about the grasp Z (a leaning book) still ends 0.34 m above the grasp.
+  Eigen::Isometry3d tilted = at_grasp;
+  tilted.linear() = f.linear() * Eigen::AngleAxisd(10.0 * M_PI / 180.0, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  EXPECT_NEAR((f.inverse() * extract_moves(tilted, f, tcp_height, grasp_z, g)[0].translation()).x(), 0.54, 1e-12);
 }
 
 }  // namespace

@@ -359,6 +359,29 @@ TEST(LibraryCycle, ResumeFromPersistedFileMidCycleAccountsForEveryBook) {
   resume_at([](const LibraryCycle& c, const FakeLibrary&) { return c.state() == CycleState::kInsert; }, "inserting");
 }
 
+TEST(LibraryCycle, ACoordinatorRestartedHalfWayUpTheExtractLiftsNoHigherThanTheFirstWould) {
+  // Found in the deployed kill test: the restarted coordinator lifted extract_lift_m (0.34 m) again from where the
+  // killed one had stopped, drove the arm into a joint limit and aborted. In the fake frame grasp X = base z.
+  const CycleSettings s = settings();
+  FakeLibrary w(three_books());
+  auto first = std::make_unique<LibraryCycle>(s, std::nullopt);
+  w.run(*first, [&] { return first->state() == CycleState::kExtract; });
+  const double grasp_z = w.ee.translation().z();
+  w.run(*first, [&] { return w.ee.translation().z() > grasp_z + 0.15; });
+  ASSERT_EQ(first->state(), CycleState::kExtract);
+  const auto progress = first->progress();
+  first.reset();
+  LibraryCycle second(s, progress);
+  const size_t from = w.tcp_path.size();
+  w.run(second, [&] { return second.state() == CycleState::kMoveToHolder || done_or_aborted(second); });
+  ASSERT_EQ(second.state(), CycleState::kMoveToHolder) << second.status().message;
+  double top = -1e9;
+  for (size_t i = from; i < w.tcp_path.size(); ++i) top = std::max(top, w.tcp_path[i].second.z());
+  EXPECT_NEAR(top, grasp_z + s.geometry.extract_lift, 0.005);
+  w.run(second, [&] { return done_or_aborted(second); });
+  EXPECT_EQ(second.state(), CycleState::kDone) << second.status().message;
+}
+
 TEST(LibraryCycle, ARestartDuringAPlannedMotionStopsTheArmBeforePlanning) {
   // The first coordinator dies while the arm executes its trajectory to the stripe station; the
   // driver would go on until its heartbeat timeout. The new one must stop that motion and plan
