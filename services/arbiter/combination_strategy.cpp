@@ -72,6 +72,21 @@ CombinationResult combine(const CombinationInputs& in, const CombinationToleranc
   // Y (Section 3.2).
   double gp_y = p2.y();
   const double dy = p2.y() - ref.y();
+  // Not in the paper: P2 left of a valid P1 beyond the Y tolerance *and* above it beyond the X
+  // tolerance is a taller left neighbour's corner (each alone the paper accepts). P1, confirmed by
+  // PS, is the right-most book's corner: grasp there.
+  if (r.p1_valid && tol.p1_over_other_book) {
+    const double dx = p2.x() - in.p1->x();
+    if (dy <= -tol.y && dx >= tol.x) {
+      r.steps.push_back(step(
+          "P2 vs P1 (left and above)", dy, tol.y, false,
+          "P2 is " + mm(-dy) + " left of and " + mm(dx) + " above P1: the corner of a taller left neighbour, GP = P1"));
+      r.gp = *in.p1;
+      r.steps.push_back(step("GP.z", 0.0, 0.0, true, "GP = P1 (GP.z = P1.z)"));
+      r.outcome = GraspOutcome::kGrasp;
+      return r;
+    }
+  }
   if (std::abs(dy) < tol.y) {
     r.steps.push_back(step("P2.y vs " + ref_name + ".y", dy, tol.y, true, "P2.y valid: within the Y tolerance"));
   } else if (dy < 0) {

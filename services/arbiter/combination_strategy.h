@@ -19,6 +19,10 @@ struct CombinationTolerances {
   double y = 0.015;        ///< grasping tolerance in Y (Section 4.1: 1.5 cm)
   double x = 0.02;         ///< grasping tolerance in X (half the plate height: 2 cm)
   int max_rank = 3;        ///< give up after BwH has tried this many regions from the right
+  /// Not in the paper: a P2 both more than `y` left of a valid P1 and more than `x` above it is
+  /// the corner of a taller left neighbour, not of the book P1 (checked against PS) belongs to;
+  /// GP is then P1. False applies the paper's rules alone, which accept such a P2 in both axes.
+  bool p1_over_other_book = true;
 };
 
 /// One decision of the strategy, with the numbers it was made on.
