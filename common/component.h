@@ -69,6 +69,11 @@ class Component {
   virtual void on_tick(int64_t now_utime);
   /// Requested tick period in seconds (0 = never). Default 0.
   virtual double tick_period_s() const { return 0.0; }
+  /// Called by the runtime once no further input message is waiting (after a burst was dispatched).
+  /// Components whose work per input is expensive (a camera's rendering) note the newest input in
+  /// their handler and do the work here, so a backlog is skipped instead of worked through late.
+  /// Returns true if it did work (it may have published). Default: nothing, false.
+  virtual bool on_inputs_drained() { return false; }
 
   /// The component's health at `now_utime` (rates over the period since the
   /// previous call). Resets the per-report counters.

@@ -40,7 +40,13 @@ void Composition::on_any(const lcm::ReceiveBuffer* rbuf, const std::string& /*ch
 int Composition::spin(int max_messages) {
   int handled = 0;
   while (max_messages < 0 || handled < max_messages) {
-    if (lcm_.handleTimeout(0) <= 0) break;
+    if (lcm_.handleTimeout(0) <= 0) {
+      // Nothing waiting: the components' deferred work (as a process would do it), which may publish.
+      bool worked = false;
+      for (auto& h : hosts_) worked = h->component().on_inputs_drained() || worked;
+      if (!worked) break;
+      continue;
+    }
     ++handled;
     for (auto& h : hosts_) h->poll(time_.now_utime());
   }

@@ -42,7 +42,9 @@ class Composition {
                          const std::string& config_yaml);
 
   /// Dispatches queued messages until the queue is empty or `max_messages`
-  /// were handled (-1 = no limit). Returns the number handled.
+  /// were handled (-1 = no limit); each time the queue is empty the
+  /// components' Component::on_inputs_drained() runs, and what they publish
+  /// is dispatched too. Returns the number of messages handled.
   int spin(int max_messages = -1);
 
   /// The bus: publish inputs here.

@@ -14,6 +14,9 @@
 namespace bookgrasp {
 namespace {
 
+/// Messages dispatched at most in one go before the status duties and the deferred work run.
+constexpr int kMaxBurst = 1000;
+
 void print_help(const ServiceDescription& d) {
   std::cout << d.name << " - " << d.summary << "\n\n"
             << "usage: " << d.name
@@ -110,6 +113,11 @@ int run_service_main(int argc, char** argv, const ServiceDescription& d) {
     const int r = lcm.handleTimeout(static_cast<int>(std::max<int64_t>(1, wait_us / 1000)));
     if (r < 0 && !bookgrasp::stop_requested()) {
       host->component().report_error("LCM handle failed");
+    } else if (r > 0) {
+      // Everything already waiting first (bounded, so the status duties still run), then the deferred work.
+      for (int i = 0; i < kMaxBurst && lcm.handleTimeout(0) > 0; ++i) {
+      }
+      host->component().on_inputs_drained();
     }
   }
   host->publish_stopping(clock.now_utime());

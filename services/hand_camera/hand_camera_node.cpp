@@ -79,7 +79,7 @@ HandCameraNode::HandCameraNode(const HandCameraSettings& settings)
 
 HandCameraNode::~HandCameraNode() = default;
 
-bool HandCameraNode::capture_sim(const sim_state_t& state, hand_image_t* out, std::string* reason) {
+bool HandCameraNode::admit_sim(const sim_state_t& state, std::string* reason) {
   reason->clear();
   if (!rig_) {
     *reason = "not the sim backend";
@@ -92,11 +92,19 @@ bool HandCameraNode::capture_sim(const sim_state_t& state, hand_image_t* out, st
     *reason = a.reason;
     return false;
   }
-  if (!a.render) return false;
+  return a.render;
+}
+
+hand_image_t HandCameraNode::render_sim(const sim_state_t& state) {
   rig_->apply(state);
   const sim_render::CameraImage img = rig_->capture("hand_camera", state.utime);
-  *out = make_hand_image(img.rgb, img.camera.to_message(state.utime), state.utime, sequence_++,
+  return make_hand_image(img.rgb, img.camera.to_message(state.utime), state.utime, sequence_++,
                          settings_.image_encoding);
+}
+
+bool HandCameraNode::capture_sim(const sim_state_t& state, hand_image_t* out, std::string* reason) {
+  if (!admit_sim(state, reason)) return false;
+  *out = render_sim(state);
   return true;
 }
 
@@ -113,13 +121,26 @@ bool HandCameraNode::next_file_frame(hand_image_t* out) {
 }
 
 void HandCameraNode::on_sim_state(const sim_state_t& state) {
-  hand_image_t img;
+  // Rendered once no newer state waits (on_inputs_drained): a camera slower than the simulation on a loaded
+  // machine then skips states instead of working through a growing backlog (images 2-3 s late, deployed).
   std::string reason;
-  if (capture_sim(state, &img, &reason)) {
-    publish(settings_.output_channel, img);
+  if (admit_sim(state, &reason)) {
+    pending_ = state;
   } else if (!reason.empty()) {
     reject(settings_.sim_state_channel, reason);
   }
+}
+
+bool HandCameraNode::on_inputs_drained() {
+  if (!pending_) return false;
+  const sim_state_t state = std::move(*pending_);
+  pending_.reset();
+  try {
+    publish(settings_.output_channel, render_sim(state));
+  } catch (const std::exception& e) {
+    report_error(std::string("rendering failed: ") + e.what());
+  }
+  return true;
 }
 
 void HandCameraNode::on_tick(int64_t /*now_utime*/) {

@@ -87,7 +87,7 @@ StereoCameraNode::StereoCameraNode(const StereoCameraSettings& settings)
 
 StereoCameraNode::~StereoCameraNode() = default;
 
-bool StereoCameraNode::capture_sim(const sim_state_t& state, stereo_frame_t* out, std::string* reason) {
+bool StereoCameraNode::admit_sim(const sim_state_t& state, std::string* reason) {
   reason->clear();
   if (!rig_) {
     *reason = "not the sim backend";
@@ -100,14 +100,22 @@ bool StereoCameraNode::capture_sim(const sim_state_t& state, stereo_frame_t* out
     *reason = a.reason;
     return false;
   }
-  if (!a.render) return false;
+  return a.render;
+}
+
+stereo_frame_t StereoCameraNode::render_sim(const sim_state_t& state) {
   rig_->apply(state);
   const sim_render::CameraImage left = rig_->capture("stereo_left", state.utime);
   const sim_render::CameraImage right = rig_->capture("stereo_right", state.utime);
   const double baseline = (left.camera.camera_in_base.translation() - right.camera.camera_in_base.translation()).norm();
-  *out = make_stereo_frame(left.rgb, right.rgb, left.camera.to_message(state.utime),
+  return make_stereo_frame(left.rgb, right.rgb, left.camera.to_message(state.utime),
                            right.camera.to_message(state.utime), baseline, state.utime, sequence_++,
                            settings_.image_encoding);
+}
+
+bool StereoCameraNode::capture_sim(const sim_state_t& state, stereo_frame_t* out, std::string* reason) {
+  if (!admit_sim(state, reason)) return false;
+  *out = render_sim(state);
   return true;
 }
 
@@ -126,13 +134,26 @@ bool StereoCameraNode::next_file_frame(stereo_frame_t* out) {
 }
 
 void StereoCameraNode::on_sim_state(const sim_state_t& state) {
-  stereo_frame_t frame;
+  // Rendered once no newer state waits (on_inputs_drained): a camera slower than the simulation on a loaded
+  // machine then skips states instead of working through a growing backlog (images 2-3 s late, deployed).
   std::string reason;
-  if (capture_sim(state, &frame, &reason)) {
-    publish(settings_.output_channel, frame);
+  if (admit_sim(state, &reason)) {
+    pending_ = state;
   } else if (!reason.empty()) {
     reject(settings_.sim_state_channel, reason);
   }
+}
+
+bool StereoCameraNode::on_inputs_drained() {
+  if (!pending_) return false;
+  const sim_state_t state = std::move(*pending_);
+  pending_.reset();
+  try {
+    publish(settings_.output_channel, render_sim(state));
+  } catch (const std::exception& e) {
+    report_error(std::string("rendering failed: ") + e.what());
+  }
+  return true;
 }
 
 void StereoCameraNode::on_tick(int64_t /*now_utime*/) {

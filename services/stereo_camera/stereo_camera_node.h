@@ -9,6 +9,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -77,6 +78,8 @@ class StereoCameraNode : public Component {
   bool next_file_frame(stereo_frame_t* out);
 
   void on_tick(int64_t now_utime) override;
+  /// Renders the newest due SIM_STATE, if any (a backlog of states is skipped, not rendered late).
+  bool on_inputs_drained() override;
   double tick_period_s() const override;
 
   /// Number of image pairs (files backend; 0 for sim).
@@ -84,12 +87,17 @@ class StereoCameraNode : public Component {
 
  private:
   void on_sim_state(const sim_state_t& state);
+  /// Admits `state` (content, seed, order, schedule): true if a frame is due; false with `*reason` for a bad state.
+  bool admit_sim(const sim_state_t& state, std::string* reason);
+  /// Renders `state`.
+  stereo_frame_t render_sim(const sim_state_t& state);
 
   StereoCameraSettings settings_;
   int64_t sequence_ = 0;
   // sim
   std::unique_ptr<sim_render::SimCameraRig> rig_;
   std::unique_ptr<sim_render::CaptureSchedule> schedule_;
+  std::optional<sim_state_t> pending_;  ///< newest due state, rendered in on_inputs_drained()
   TimeOrderGuard order_;
   // files
   std::vector<sim_render::ImagePairFiles> pairs_;

@@ -97,7 +97,7 @@ void ServoSession::advance(int64_t utime, SessionOutput* out) {
   }
   // Times since the last good measurement ARRIVED (message time), not since its image was taken: the
   // camera -> detector pipeline of separate processes has a latency (0.05-0.25 s on a quiet machine,
-  // ~0.7 s when it is loaded) that the control law compensates with the pose at capture time. Until
+  // ~0.7 s when it is loaded); the stripe servo's law subtracts the motion since capture. Until
   // the first image taken after the start has arrived, the pose history's length is allowed on top.
   const double since_good = (now_ - last_good_utime_) * 1e-6;
   const double lost_limit_s = p_.feature_lost_timeout_s + (measured_since_start_ ? 0.0 : p_.pose_history_s);
@@ -247,7 +247,11 @@ SessionOutput ServoSession::on_stripe(int64_t utime, const StripeObservation& ob
   if (!running_ || mode_ != ServoMode::kStripeEnd) return out;
   if (!accept_measurement_time(utime)) return out;
   const double travelled = (tcp_.translation() - start_position_).norm();
-  const StripeServoStep s = stripe_.step(obs, standoff_, travelled);
+  // The TCP's motion since the image was taken, in the gripper frame at capture (x up, y right).
+  Eigen::Vector2d moved = Eigen::Vector2d::Zero();
+  if (const auto at_capture = pose_at(utime))
+    moved = (at_capture->linear().transpose() * (tcp_.translation() - at_capture->translation())).head<2>();
+  const StripeServoStep s = stripe_.step(obs, standoff_, travelled, moved);
   if (s.failed) {
     finish(ServoState::kFeatureLost, s.note, &out);
     return out;

@@ -18,7 +18,8 @@ void StripeEndServo::reset() {
   missing_in_track_ = 0;
 }
 
-StripeServoStep StripeEndServo::step(const StripeObservation& obs, double standoff_m, double travelled_m) {
+StripeServoStep StripeEndServo::step(const StripeObservation& obs, double standoff_m, double travelled_m,
+                                     const Eigen::Vector2d& moved_since_capture_m) {
   StripeServoStep out;
   out.target_px = geo_.target_pixel(standoff_m);
   const double ut = out.target_px.x();
@@ -105,12 +106,16 @@ StripeServoStep StripeEndServo::step(const StripeObservation& obs, double stando
     return out;
   }
   out.error_m = p.head<2>();
+  // The end is fixed on the board: what is left of the error now is the image's minus the motion since.
+  const Eigen::Vector2d e = p_.compensate_capture_delay && moved_since_capture_m.allFinite()
+                                ? Eigen::Vector2d(p.head<2>() - moved_since_capture_m)
+                                : Eigen::Vector2d(p.head<2>());
   GripperTwist t = GripperTwist::Zero();
-  t(0) = p_.gain * p.x();
-  t(1) = p_.gain * p.y();
+  t(0) = p_.gain * e.x();
+  t(1) = p_.gain * e.y();
   const double tol[2] = {p_.converged_x_m, p_.converged_y_m};
   for (int k = 0; k < 2; ++k)
-    if (std::abs(p(k)) > tol[k] && std::abs(t(k)) < p_.min_track_speed) t(k) = std::copysign(p_.min_track_speed, p(k));
+    if (std::abs(e(k)) > tol[k] && std::abs(t(k)) < p_.min_track_speed) t(k) = std::copysign(p_.min_track_speed, e(k));
   out.twist = saturate_twist(t, p_.max_linear_speed, 1.0);
   const bool ok = std::abs(p.x()) <= p_.converged_x_m && std::abs(p.y()) <= p_.converged_y_m;
   in_tolerance_ = ok ? in_tolerance_ + 1 : 0;

@@ -52,6 +52,9 @@ struct StripeEndServoParams {
   double occlusion_min_segment_px = 0.0;  ///< with require_occlusion: an end is accepted only on a visible segment at
                                           ///< least this long (shorter ones are the stripe seen through gaps between
                                           ///< books on the way past them)
+  bool compensate_capture_delay = true;   ///< TRACK: the twist acts on the measured error minus the TCP's motion since
+                                          ///< the image was taken (the end is fixed on the board); false = on the
+                                          ///< measured error alone, which overshoots when images arrive late
   int track_lost_frames = 0;              ///< TRACK: the end missing on this many consecutive observations -> back to
                                           ///< SEARCH (an end seen through a gap between books disappears as the
                                           ///< camera moves); 0 = never (the session reports FEATURE_LOST)
@@ -90,8 +93,11 @@ class StripeEndServo {
   /// Back to SEARCH, occlusion not seen, convergence count 0.
   void reset();
   /// One step for observation `obs`, the board `standoff_m` ahead of the TCP,
-  /// after `travelled_m` of TCP travel since the start.
-  StripeServoStep step(const StripeObservation& obs, double standoff_m, double travelled_m);
+  /// after `travelled_m` of TCP travel since the start. `moved_since_capture_m`: how far the TCP has
+  /// moved (gripper x up, y right) between the image's capture and now; with compensate_capture_delay
+  /// TRACK's twist acts on the error that is left now, while convergence is judged on the image.
+  StripeServoStep step(const StripeObservation& obs, double standoff_m, double travelled_m,
+                       const Eigen::Vector2d& moved_since_capture_m = Eigen::Vector2d::Zero());
 
   /// Current phase.
   StripePhase phase() const { return phase_; }

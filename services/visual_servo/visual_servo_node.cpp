@@ -78,6 +78,7 @@ VisualServoSettings VisualServoSettings::from_config(const Config& root) {
   if (st.has("min_track_speed")) s.stripe.min_track_speed = st.get_double("min_track_speed", 0.0, 0.1);
   if (st.has("occlusion_min_segment_px"))
     s.stripe.occlusion_min_segment_px = st.get_double("occlusion_min_segment_px", 0.0, 10000.0);
+  s.stripe.compensate_capture_delay = st.get<bool>("compensate_capture_delay");
   if (st.has("track_lost_frames")) s.stripe.track_lost_frames = st.get_int("track_lost_frames", 0, 1000);
   return s;
 }

@@ -113,5 +113,30 @@ TEST(HandCameraSim, PoseAtCaptureFollowsTheStateAndBadStatesAreRejected) {
   EXPECT_EQ(col.got.size(), 3u);
 }
 
+TEST(HandCameraSim, ABacklogOfStatesIsSkippedAndOnlyTheNewestDueOneRendered) {
+  // A camera slower than the simulation: three due states (0.1 s apart) wait when it gets to them. It renders
+  // the newest once they are dispatched, not each in turn (images 2-3 s late in the deployed kill test).
+  HandCameraSettings s = default_settings("sim");
+  s.seed = 1;
+  scene::SimModel sim = scene::SimModel::build(scene::load_scene(s.scene_file, 1));
+  Composition comp;
+  comp.add(std::make_unique<HandCameraNode>(s));
+  Collector col;
+  comp.bus().subscribe("HAND_IMAGE", &Collector::on, &col);
+  for (int k = 0; k < 3; ++k) {
+    const sim_state_t st = sim.state(k * 100000);
+    comp.bus().publish("SIM_STATE", &st);
+  }
+  comp.spin();
+  ASSERT_EQ(col.got.size(), 1u);
+  EXPECT_EQ(col.got[0].utime, 200000);
+  // The next due state, alone, is rendered as before.
+  const sim_state_t next = sim.state(300000);
+  comp.bus().publish("SIM_STATE", &next);
+  comp.spin();
+  ASSERT_EQ(col.got.size(), 2u);
+  EXPECT_EQ(col.got[1].utime, 300000);
+}
+
 }  // namespace
 }  // namespace bookgrasp

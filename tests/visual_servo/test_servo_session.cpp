@@ -2,6 +2,9 @@
 // timeout, start checks, cancel, stale/mismatched measurements, converged pose at capture.
 #include <gtest/gtest.h>
 
+#include <deque>
+#include <utility>
+
 #include "services/visual_servo/servo_session.h"
 #include "servo_plant.h"
 
@@ -236,6 +239,69 @@ TEST_F(Fixture, ArmDriverStopFailsTheTask) {
   arm(kT0 + 30'000, 0, ArmCondition::kStopped, "workspace limit: TCP z 1.31 > 1.30");
   EXPECT_EQ(last_report().state, ServoState::kFailed);
   EXPECT_NE(last_report().message.find("workspace limit"), std::string::npos);
+}
+
+/// The stripe servo closed through the session: images every 0.1 s reach it `latency_s` after they were taken
+/// (the deployed camera -> detector pipeline on a loaded machine), arm states every 10 ms with the TCP following
+/// the last command. Returns the final report and the TCP.
+std::pair<ServoReport, Eigen::Isometry3d> run_late_stripe(double latency_s, bool compensate) {
+  const HandEyeGeometry geo = test::project_geometry();
+  StripeEndServoParams sp;
+  sp.gain = 1.2;
+  sp.max_linear_speed = 0.06;
+  sp.search_direction = -1;
+  sp.require_occlusion = false;
+  sp.min_track_speed = 0.004;
+  sp.compensate_capture_delay = compensate;
+  ServoSession session{geo, session_params(), BookCornerServoParams{}, sp};
+  // The true end at Y = books_right = 0.15. The visible end is where the books' edge hides the stripe, so it moves
+  // with the camera: books 0.30 deep in front of the board 0.50 away move it (0.5 / 0.3 =) 1.7 times as fast as the
+  // camera, about as the cart's 0.15-0.25 m deep books do at the coordinator's 0.43 m standoff.
+  test::StripeScene scene;
+  scene.books_z = 0.30;
+  Eigen::Isometry3d tcp = Eigen::Isometry3d::Identity();
+  tcp.translation() = Eigen::Vector3d(0.01, 0.30, 0.0);  // 15 cm right of the end: its left end is in view
+  std::vector<ServoReport> reports;
+  GripperTwist twist = GripperTwist::Zero();
+  auto take = [&](const SessionOutput& o) {
+    for (const auto& c : o.commands) twist = c.stop ? GripperTwist::Zero() : c.twist;
+    reports.insert(reports.end(), o.reports.begin(), o.reports.end());
+  };
+  take(session.on_arm_state(kT0, tcp, ArmCondition::kIdle, ""));
+  ServoRequest r;
+  r.utime = kT0;
+  r.request_id = 9;
+  r.mode = ServoMode::kStripeEnd;
+  r.standoff_m = scene.board_z;
+  r.timeout_s = 30;
+  take(session.on_request(r));
+  std::deque<std::pair<int64_t, StripeObservation>> in_flight;  // (capture time, what BSwH saw)
+  const int64_t latency_us = static_cast<int64_t>(latency_s * 1e6);
+  for (int i = 1; i <= 3100 && session.running(); ++i) {
+    const int64_t t = kT0 + i * 10'000;
+    tcp = test::integrate(tcp, twist, 0.01);
+    take(session.on_arm_state(t, tcp, ArmCondition::kExecuting, ""));
+    if (i % 10 == 0) in_flight.emplace_back(t, scene.observe(geo, tcp));
+    while (!in_flight.empty() && in_flight.front().first + latency_us <= t) {
+      take(session.on_stripe(in_flight.front().first, in_flight.front().second, ""));
+      in_flight.pop_front();
+    }
+  }
+  return {reports.back(), tcp};
+}
+
+TEST(StripeServoLatency, ImagesASecondLateStillConvergeOnTheTrueEnd) {
+  // Without the motion since capture subtracted, the loop swings past the end and back until its timeout (as the
+  // deployed stripe servo did, +-100 px around the end); with it, it converges as with fresh images.
+  for (const double latency : {0.0, 0.7, 1.0}) {
+    const auto [report, tcp] = run_late_stripe(latency, true);
+    ASSERT_EQ(report.state, ServoState::kConverged) << "latency " << latency << ": " << report.message;
+    ASSERT_TRUE(report.converged_pose.has_value());
+    EXPECT_NEAR(report.converged_pose->translation().y(), 0.15, 1.5e-3) << "latency " << latency;
+    EXPECT_NEAR(report.converged_pose->translation().x(), 0.0, 1.5e-3) << "latency " << latency;
+  }
+  const auto [uncompensated, tcp] = run_late_stripe(1.0, false);
+  EXPECT_NE(uncompensated.state, ServoState::kConverged) << "the test plant no longer shows the overshoot";
 }
 
 }  // namespace
