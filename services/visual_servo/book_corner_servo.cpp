@@ -18,7 +18,8 @@ GripperTwist saturate_twist(const GripperTwist& twist, double max_linear, double
 BookCornerServo::BookCornerServo(const HandEyeGeometry& geometry, const BookCornerServoParams& params)
     : geo_(geometry), p_(params) {}
 
-CornerServoStep BookCornerServo::step(const Eigen::Vector2d& r_px, double slope_rad, double standoff_m) {
+CornerServoStep BookCornerServo::step(const Eigen::Vector2d& r_px, double slope_rad, double standoff_m,
+                                      const Eigen::Vector3d& moved_since_capture) {
   CornerServoStep out;
   const CameraIntrinsics& k = geo_.intrinsics();
   out.target_px = geo_.target_pixel(standoff_m);
@@ -46,6 +47,12 @@ CornerServoStep BookCornerServo::step(const Eigen::Vector2d& r_px, double slope_
     j(2, c) = -cam(5);  // the image rotates opposite to the camera about its z
   }
   Eigen::Vector3d e(out.error_px.x(), out.error_px.y(), out.slope_error_rad);
+  // R is fixed in the world: the TCP's motion since capture has moved it in the image by about j * motion.
+  if (p_.compensate_capture_delay && moved_since_capture.allFinite()) {
+    Eigen::Vector3d m = moved_since_capture;
+    if (!p_.align_slope) m(2) = 0;
+    e += j * m;
+  }
   Eigen::Vector3d lambda(p_.gain, p_.gain, p_.slope_gain);
   Eigen::Vector3d u;
   if (p_.align_slope) {

@@ -28,6 +28,9 @@ struct BookCornerServoParams {
   double converged_slope_rad = 0.01; ///< ... and |slope| below this ...
   int converged_frames = 3;          ///< ... on this many consecutive measurements
   bool align_slope = true;           ///< rotate about the approach axis to zero the slope
+  bool compensate_capture_delay = true;  ///< the twist acts on the image's error plus what the TCP's motion since
+                                         ///< the image was taken has moved R by (the corner is a fixed point);
+                                         ///< false = on the image's error alone, which overshoots with late images
 };
 
 /// One control step.
@@ -50,7 +53,11 @@ class BookCornerServo {
   /// One step for corner `r_px` and image slope `slope_rad` (BwH convention:
   /// atan2(dy, dx), image y down) of a book whose front is `standoff_m` ahead
   /// of the TCP.
-  CornerServoStep step(const Eigen::Vector2d& r_px, double slope_rad, double standoff_m);
+  /// `moved_since_capture`: the TCP's motion between the image's capture and now (gripper x, y in metres and the
+  /// rotation about its z in radians); with compensate_capture_delay the twist acts on the error predicted for
+  /// now (first order, through the interaction matrix), while convergence is judged on the image.
+  CornerServoStep step(const Eigen::Vector2d& r_px, double slope_rad, double standoff_m,
+                       const Eigen::Vector3d& moved_since_capture = Eigen::Vector3d::Zero());
 
   /// The parameters.
   const BookCornerServoParams& params() const { return p_; }

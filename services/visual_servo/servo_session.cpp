@@ -213,6 +213,15 @@ bool ServoSession::accept_measurement_time(int64_t utime) {
   return true;
 }
 
+Eigen::Vector3d ServoSession::moved_since(int64_t capture_utime) const {
+  const auto at_capture = pose_at(capture_utime);
+  if (!at_capture) return Eigen::Vector3d::Zero();
+  const Eigen::Matrix3d r = at_capture->linear();
+  const Eigen::Vector3d d = r.transpose() * (tcp_.translation() - at_capture->translation());
+  const Eigen::Matrix3d turned = r.transpose() * tcp_.linear();
+  return Eigen::Vector3d(d.x(), d.y(), std::atan2(turned(1, 0), turned(0, 0)));
+}
+
 SessionOutput ServoSession::on_book(const BookObservation& obs) {
   SessionOutput out;
   advance(obs.utime, &out);
@@ -224,7 +233,7 @@ SessionOutput ServoSession::on_book(const BookObservation& obs) {
     out.reports.push_back(report(ServoState::kRunning, "feature not seen: " + last_lost_reason_));
     return out;
   }
-  const CornerServoStep s = corner_.step(obs.r_px, obs.slope_rad, standoff_);
+  const CornerServoStep s = corner_.step(obs.r_px, obs.slope_rad, standoff_, moved_since(obs.utime));
   ++iterations_;
   error_px_ = s.error_px;
   slope_error_ = s.slope_error_rad;
@@ -247,11 +256,7 @@ SessionOutput ServoSession::on_stripe(int64_t utime, const StripeObservation& ob
   if (!running_ || mode_ != ServoMode::kStripeEnd) return out;
   if (!accept_measurement_time(utime)) return out;
   const double travelled = (tcp_.translation() - start_position_).norm();
-  // The TCP's motion since the image was taken, in the gripper frame at capture (x up, y right).
-  Eigen::Vector2d moved = Eigen::Vector2d::Zero();
-  if (const auto at_capture = pose_at(utime))
-    moved = (at_capture->linear().transpose() * (tcp_.translation() - at_capture->translation())).head<2>();
-  const StripeServoStep s = stripe_.step(obs, standoff_, travelled, moved);
+  const StripeServoStep s = stripe_.step(obs, standoff_, travelled, moved_since(utime).head<2>());
   if (s.failed) {
     finish(ServoState::kFeatureLost, s.note, &out);
     return out;

@@ -141,6 +141,9 @@ class ServoSession {
   void command(const GripperTwist& twist, SessionOutput* out);
   ServoReport report(ServoState state, const std::string& message) const;
   std::optional<Eigen::Isometry3d> pose_at(int64_t utime) const;
+  /// The TCP's motion from the pose at `capture_utime` to now, in the gripper frame at capture:
+  /// (x, y) in metres and the rotation about z in radians. Zero without a pose history.
+  Eigen::Vector3d moved_since(int64_t capture_utime) const;
   bool accept_measurement_time(int64_t utime);
 
   HandEyeGeometry geo_;

@@ -2,6 +2,7 @@
 // timeout, start checks, cancel, stale/mismatched measurements, converged pose at capture.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <deque>
 #include <utility>
 
@@ -302,6 +303,70 @@ TEST(StripeServoLatency, ImagesASecondLateStillConvergeOnTheTrueEnd) {
   }
   const auto [uncompensated, tcp] = run_late_stripe(1.0, false);
   EXPECT_NE(uncompensated.state, ServoState::kConverged) << "the test plant no longer shows the overshoot";
+}
+
+/// The corner servo closed through the session, images every 0.1 s reaching it `latency_s` after capture, arm states
+/// every 10 ms, the TCP following the last command; the corner 4 cm up and 3 cm right of the start, its top edge
+/// rolled 3 degrees. Returns the final report.
+ServoReport run_late_corner(double latency_s, bool compensate) {
+  const HandEyeGeometry geo = test::project_geometry();
+  BookCornerServoParams cp;
+  cp.gain = 2.0;
+  cp.slope_gain = 2.0;
+  cp.max_linear_speed = 0.06;
+  cp.max_angular_speed = 0.3;
+  cp.converged_px = 2.0;
+  cp.converged_slope_rad = 1.5 * M_PI / 180.0;
+  cp.compensate_capture_delay = compensate;
+  ServoSession session{geo, session_params(), cp, StripeEndServoParams{}};
+  test::CornerScene scene;
+  scene.corner = Eigen::Vector3d(0.04, 0.03, 0.22);
+  scene.roll_rad = 3.0 * M_PI / 180.0;
+  Eigen::Isometry3d tcp = Eigen::Isometry3d::Identity();
+  std::vector<ServoReport> reports;
+  GripperTwist twist = GripperTwist::Zero();
+  auto take = [&](const SessionOutput& o) {
+    for (const auto& c : o.commands) twist = c.stop ? GripperTwist::Zero() : c.twist;
+    reports.insert(reports.end(), o.reports.begin(), o.reports.end());
+  };
+  take(session.on_arm_state(kT0, tcp, ArmCondition::kIdle, ""));
+  ServoRequest r;
+  r.utime = kT0;
+  r.request_id = 11;
+  r.mode = ServoMode::kBookCorner;
+  r.standoff_m = 0.22;
+  r.timeout_s = 20;
+  take(session.on_request(r));
+  std::deque<BookObservation> in_flight;
+  const int64_t latency_us = static_cast<int64_t>(latency_s * 1e6);
+  for (int i = 1; i <= 2100 && session.running(); ++i) {
+    const int64_t t = kT0 + i * 10'000;
+    tcp = test::integrate(tcp, twist, 0.01);
+    take(session.on_arm_state(t, tcp, ArmCondition::kExecuting, ""));
+    if (i % 10 == 0) {
+      BookObservation o;
+      o.utime = t;
+      o.found = scene.observe(geo, tcp, &o.r_px, &o.slope_rad);
+      in_flight.push_back(o);
+    }
+    while (!in_flight.empty() && in_flight.front().utime + latency_us <= t) {
+      take(session.on_book(in_flight.front()));
+      in_flight.pop_front();
+    }
+  }
+  return reports.back();
+}
+
+TEST(CornerServoLatency, ImagesASecondLateStillConvergeOnTheTrueCorner) {
+  for (const double latency : {0.0, 0.7, 1.0}) {
+    const ServoReport report = run_late_corner(latency, true);
+    ASSERT_EQ(report.state, ServoState::kConverged) << "latency " << latency << ": " << report.message;
+    ASSERT_TRUE(report.converged_pose.has_value());
+    // The TCP axis through the corner (the target pixel is R straight ahead at the standoff).
+    EXPECT_NEAR(report.converged_pose->translation().x(), 0.04, 1.5e-3) << "latency " << latency;
+    EXPECT_NEAR(report.converged_pose->translation().y(), 0.03, 1.5e-3) << "latency " << latency;
+  }
+  EXPECT_NE(run_late_corner(1.0, false).state, ServoState::kConverged) << "the plant no longer shows the overshoot";
 }
 
 }  // namespace
