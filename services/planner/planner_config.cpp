@@ -111,6 +111,7 @@ PlannerSettings PlannerSettings::from_config(const Config& root) {
   p.cell_ik_iterations = cb.get_int("ik_iterations", 1, 10000);
 
   s.geometry = scene_geometry_from_config(root.child("scene"));
+  s.defer_until_markers = root.get<bool>("scene.defer_until_markers");
   return s;
 }
 

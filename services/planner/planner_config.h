@@ -35,6 +35,9 @@ struct PlannerSettings {
   double default_time_budget_s = 1.0;
   double max_time_budget_s = 10.0;
   SceneGeometry geometry;
+  /// A request that arrives before the first MARKERS (a planner restarted while the task runs) is answered
+  /// once they arrive instead of at the cart's and holder's nominal poses (`scene.defer_until_markers`).
+  bool defer_until_markers = true;
 
   /// Reads every key (all required); throws ConfigError naming a bad key.
   static PlannerSettings from_config(const Config& root);

@@ -140,6 +140,17 @@ plan_result_t PlannerNode::process(const plan_request_t& req) const {
 }
 
 void PlannerNode::on_request(const plan_request_t& request) {
+  // Restarted while the task runs, the planner knows the cart and the holder only at their nominal poses until
+  // the first MARKERS: a plan there can drive the held book into the cart. The request waits for them (a newer
+  // one replaces it; the requester's own timeout still applies).
+  if (settings_.defer_until_markers && marker_poses_.empty()) {
+    deferred_ = request;
+    return;
+  }
+  answer(request);
+}
+
+void PlannerNode::answer(const plan_request_t& request) {
   const plan_result_t result = process(request);
   if (result.failure == plan_result_t::INVALID_REQUEST) reject(settings_.channel_plan_request, result.message);
   publish(settings_.channel_plan_result, result);
@@ -147,7 +158,15 @@ void PlannerNode::on_request(const plan_request_t& request) {
 
 void PlannerNode::on_markers(const marker_detections_t& markers) {
   std::string reason;
-  if (!apply_markers(markers, &reason)) reject(settings_.channel_markers, reason);
+  if (!apply_markers(markers, &reason)) {
+    reject(settings_.channel_markers, reason);
+    return;
+  }
+  if (deferred_ && !marker_poses_.empty()) {
+    const plan_request_t r = std::move(*deferred_);
+    deferred_.reset();
+    answer(r);
+  }
 }
 
 }  // namespace bookgrasp

@@ -8,6 +8,7 @@
 
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include "bookgrasp/marker_detections_t.hpp"
@@ -37,11 +38,13 @@ class PlannerNode : public Component {
  private:
   void on_request(const plan_request_t& request);
   void on_markers(const marker_detections_t& markers);
+  void answer(const plan_request_t& request);
 
   PlannerSettings settings_;
   std::unique_ptr<PlannerStack> stack_;
   PlanningScene scene_;  ///< environment only (no attached book)
   std::map<std::string, Eigen::Isometry3d> marker_poses_;
+  std::optional<plan_request_t> deferred_;  ///< the newest request waiting for the first MARKERS
 };
 
 }  // namespace bookgrasp

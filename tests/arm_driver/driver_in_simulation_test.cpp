@@ -37,8 +37,9 @@ class DriverInSimulation : public testing::Test {
     sim_settings.drive = "external";  // the test advances simulation time itself
     sim_ = &comp_.add(std::make_unique<SimWorldNode>(sim_settings));
     comp_.add(std::make_unique<ArmDriverNode>(Config::load_file(kSrc + "/config/services/arm_driver.yaml")));
-    comp_.add(std::make_unique<PlannerNode>(
-        PlannerSettings::from_config(Config::load_file(kSrc + "/config/services/planner.yaml"))));
+    PlannerSettings planner = PlannerSettings::from_config(Config::load_file(kSrc + "/config/services/planner.yaml"));
+    planner.defer_until_markers = false;  // no marker detector here: the nominal scene
+    comp_.add(std::make_unique<PlannerNode>(planner));
     comp_.bus().subscribe("ARM_STATE", &Latest<arm_state_t>::on, &state_);
     comp_.bus().subscribe("PLAN_RESULT", &Latest<plan_result_t>::on, &plan_);
     t_ = sim_->world().now_utime();

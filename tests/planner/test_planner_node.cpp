@@ -155,7 +155,9 @@ TEST_F(PlannerNodeTest, CartMarkerMovesTheCartBoxes) {
 
 TEST(PlannerNodeBus, AnswersOnTheBus) {
   Composition comp;
-  auto& node = comp.add(std::make_unique<PlannerNode>(PlannerSettings::load(kConfig)));
+  PlannerSettings settings = PlannerSettings::load(kConfig);
+  settings.defer_until_markers = false;  // plans at the nominal poses (the next test waits for MARKERS)
+  auto& node = comp.add(std::make_unique<PlannerNode>(settings));
   (void)node;
   struct Sink {
     std::vector<plan_result_t> got;
@@ -173,6 +175,46 @@ TEST(PlannerNodeBus, AnswersOnTheBus) {
   EXPECT_TRUE(sink.got[0].success) << sink.got[0].message;
   EXPECT_EQ(sink.got[1].request_id, 43);
   EXPECT_EQ(sink.got[1].failure, plan_result_t::UNKNOWN_PLANNER);
+}
+
+TEST(PlannerNodeBus, ARequestBeforeTheFirstMarkersIsAnsweredWhenTheyArrive) {
+  // A planner restarted while the task runs: the coordinator's request comes before the first MARKERS.
+  Composition comp;
+  comp.add(std::make_unique<PlannerNode>(PlannerSettings::load(kConfig)));
+  struct Sink {
+    std::vector<plan_result_t> got;
+    void on(const lcm::ReceiveBuffer*, const std::string&, const plan_result_t* msg) { got.push_back(*msg); }
+  } sink;
+  comp.bus().subscribe("PLAN_RESULT", &Sink::on, &sink);
+  plan_request_t first = joint_request(kHome, kUp);
+  first.request_id = 50;
+  comp.bus().publish("PLAN_REQUEST", &first);
+  plan_request_t second = joint_request(kHome, kUp);
+  second.request_id = 51;
+  comp.bus().publish("PLAN_REQUEST", &second);
+  comp.spin();
+  EXPECT_TRUE(sink.got.empty()) << "answered at the nominal cart pose";
+  marker_detections_t m;
+  m.utime = 7;
+  m.num_markers = 0;  // a message without cart or holder changes nothing
+  comp.bus().publish("MARKERS", &m);
+  comp.spin();
+  EXPECT_TRUE(sink.got.empty());
+  const PlannerSettings settings = PlannerSettings::load(kConfig);
+  const auto& g = settings.geometry.marker_groups[0];
+  marker_t tag;
+  tag.utime = 8;
+  tag.role = g.role;
+  tag.pose_in_base = isometry_to_pose(g.nominal_object_in_base * g.marker_in_object, "base", "marker", 8);
+  tag.pose_in_camera = tag.pose_in_base;
+  m.utime = 8;
+  m.num_markers = 1;
+  m.markers = {tag};
+  comp.bus().publish("MARKERS", &m);
+  comp.spin();
+  ASSERT_EQ(sink.got.size(), 1u) << "the newest waiting request only";
+  EXPECT_EQ(sink.got[0].request_id, 51);
+  EXPECT_TRUE(sink.got[0].success) << sink.got[0].message;
 }
 
 }  // namespace
