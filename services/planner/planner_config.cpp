@@ -75,6 +75,7 @@ PlannerSettings PlannerSettings::from_config(const Config& root) {
   s.held_book.top_above_tcp_m = hb.get_double("top_above_tcp_m", -0.5, 0.5);
   s.held_book.behind_tcp_m = hb.get_double("behind_tcp_m", -0.5, 0.5);
   s.held_book.max_tilt_rad = hb.get_double("max_tilt_deg", 0.0, 90.0) * M_PI / 180.0;
+  s.held_book.environment_margin_m = hb.get_double("environment_margin_m", 0.0, 0.5);
 
   const Config pl = root.child("planner");
   MotionPlannerParams& p = s.planner;
@@ -131,6 +132,7 @@ AttachedBox held_book_box(const Eigen::Vector3d& whd, const HeldBookParams& para
   box.pose_in_tip.translation() =
       Eigen::Vector3d(params.top_above_tcp_m - 0.5 * whd[1], 0.0, 0.5 * whd[2] - params.behind_tcp_m);
   box.touch_links = params.touch_links;
+  box.environment_margin_m = params.environment_margin_m;
   return box;
 }
 

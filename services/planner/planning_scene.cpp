@@ -181,7 +181,11 @@ void PlanningScene::attach(const AttachedBox& box) {
   part.attached = true;
   part.origin = box.pose_in_tip;
   part.exact = make_shape(s, 0.0);
-  part.env_inflated = make_shape(s, params_.environment_margin_m);
+  // At most the scene's margin: check() prefilters with the scene's margin around the bounding sphere.
+  const double env_margin = box.environment_margin_m < 0
+                                ? params_.environment_margin_m
+                                : std::min(box.environment_margin_m, params_.environment_margin_m);
+  part.env_inflated = make_shape(s, env_margin);
   part.self_inflated = make_shape(s, params_.self_margin_m);
   part.bound_radius = bound_radius(s);
   geo_->parts.push_back(part);

@@ -30,6 +30,9 @@ struct AttachedBox {
   Eigen::Isometry3d pose_in_tip = Eigen::Isometry3d::Identity();  ///< box centre in the tip (gripper) frame
   Eigen::Vector3d size = Eigen::Vector3d::Zero();                 ///< full edge lengths, metres
   std::vector<std::string> touch_links;  ///< robot links it may touch (palm, fingers)
+  /// Its distance to keep from the environment: < 0 the scene's environment margin, else this (at most the
+  /// scene's). A measured book may enter a gap the robot's margins were not chosen for.
+  double environment_margin_m = -1.0;
 };
 
 /// Settings of the collision checks.

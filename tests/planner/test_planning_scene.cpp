@@ -97,6 +97,28 @@ TEST(PlanningScene, AttachedBookCollidesAndDetaches) {
   EXPECT_TRUE(s.is_valid(kZero));
 }
 
+TEST(PlanningScene, AHeldBookKeepsItsOwnSmallerMargin) {
+  // The book reaches z = 1.4761; a ceiling 12 mm above it is within the scene's 2 cm but outside the book's 8 mm.
+  PlanningScene s = make_scene(0.02);
+  AttachedBox book;
+  book.size = Eigen::Vector3d(0.15, 0.02, 0.2);
+  book.pose_in_tip.translation() = Eigen::Vector3d(0, 0, 0.1);
+  book.touch_links = {"gripper_palm", "gripper_finger_left", "gripper_finger_right"};
+  s.set_environment({box("ceiling", {0, 0, 1.4761 + 0.012 + 0.01}, {0.5, 0.5, 0.02})});
+  s.attach(book);
+  const CollisionReport r = s.check(kZero);
+  ASSERT_TRUE(r.collision);
+  EXPECT_EQ(r.first, "held_book");
+  book.environment_margin_m = 0.008;
+  s.attach(book);
+  EXPECT_TRUE(s.is_valid(kZero)) << s.check(kZero).first << " / " << s.check(kZero).second;
+  book.environment_margin_m = 0.05;  // never more than the scene's (its prefilter uses the scene's)
+  s.attach(book);
+  EXPECT_EQ(s.check(kZero).first, "held_book");
+  s.set_environment({box("ceiling", {0, 0, 1.4761 + 0.03 + 0.01}, {0.5, 0.5, 0.02})});
+  EXPECT_TRUE(s.is_valid(kZero));
+}
+
 TEST(PlanningScene, AdjacentLinksAndFingersAreAllowed) {
   const PlanningScene s = make_scene();
   const auto pairs = s.allowed_pairs();
