@@ -153,17 +153,20 @@ TEST_F(PlannerNodeTest, CartMarkerMovesTheCartBoxes) {
   EXPECT_NEAR(find("cart_upper_shelf").pose.translation().x(), 0.89, 1e-6);
 }
 
+/// Collects the PLAN_RESULT messages of a bus.
+struct ResultSink {
+  std::vector<plan_result_t> got;
+  void on(const lcm::ReceiveBuffer*, const std::string&, const plan_result_t* msg) { got.push_back(*msg); }
+};
+
 TEST(PlannerNodeBus, AnswersOnTheBus) {
   Composition comp;
   PlannerSettings settings = PlannerSettings::load(kConfig);
   settings.defer_until_markers = false;  // plans at the nominal poses (the next test waits for MARKERS)
   auto& node = comp.add(std::make_unique<PlannerNode>(settings));
   (void)node;
-  struct Sink {
-    std::vector<plan_result_t> got;
-    void on(const lcm::ReceiveBuffer*, const std::string&, const plan_result_t* msg) { got.push_back(*msg); }
-  } sink;
-  comp.bus().subscribe("PLAN_RESULT", &Sink::on, &sink);
+  ResultSink sink;
+  comp.bus().subscribe("PLAN_RESULT", &ResultSink::on, &sink);
   plan_request_t good = joint_request(kHome, kUp);
   comp.bus().publish("PLAN_REQUEST", &good);
   plan_request_t bad = joint_request(kHome, kUp);
@@ -181,11 +184,8 @@ TEST(PlannerNodeBus, ARequestBeforeTheFirstMarkersIsAnsweredWhenTheyArrive) {
   // A planner restarted while the task runs: the coordinator's request comes before the first MARKERS.
   Composition comp;
   comp.add(std::make_unique<PlannerNode>(PlannerSettings::load(kConfig)));
-  struct Sink {
-    std::vector<plan_result_t> got;
-    void on(const lcm::ReceiveBuffer*, const std::string&, const plan_result_t* msg) { got.push_back(*msg); }
-  } sink;
-  comp.bus().subscribe("PLAN_RESULT", &Sink::on, &sink);
+  ResultSink sink;
+  comp.bus().subscribe("PLAN_RESULT", &ResultSink::on, &sink);
   plan_request_t first = joint_request(kHome, kUp);
   first.request_id = 50;
   comp.bus().publish("PLAN_REQUEST", &first);

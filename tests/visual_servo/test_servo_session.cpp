@@ -242,9 +242,39 @@ TEST_F(Fixture, ArmDriverStopFailsTheTask) {
   EXPECT_NE(last_report().message.find("workspace limit"), std::string::npos);
 }
 
-/// The stripe servo closed through the session: images every 0.1 s reach it `latency_s` after they were taken
-/// (the deployed camera -> detector pipeline on a loaded machine), arm states every 10 ms with the TCP following
-/// the last command. Returns the final report and the TCP.
+/// Closes `session` (its task started by `request`) on a kinematic arm from `tcp`: an arm state every 10 ms with
+/// the TCP following the last command, an image every 0.1 s (`capture(t, tcp)` gives what the detector saw) reaching
+/// the session through `deliver(capture_time, observation)` `latency_s` after it was taken (the deployed camera ->
+/// detector pipeline on a loaded machine), for at most `ticks` arm states. Returns the last report and the TCP.
+template <typename Capture, typename Deliver>
+std::pair<ServoReport, Eigen::Isometry3d> run_with_late_images(ServoSession& session, Eigen::Isometry3d tcp,
+                                                               const ServoRequest& request, double latency_s, int ticks,
+                                                               Capture capture, Deliver deliver) {
+  std::vector<ServoReport> reports;
+  GripperTwist twist = GripperTwist::Zero();
+  auto take = [&](const SessionOutput& o) {
+    for (const auto& c : o.commands) twist = c.stop ? GripperTwist::Zero() : c.twist;
+    reports.insert(reports.end(), o.reports.begin(), o.reports.end());
+  };
+  take(session.on_arm_state(kT0, tcp, ArmCondition::kIdle, ""));
+  take(session.on_request(request));
+  using Observation = decltype(capture(int64_t{0}, tcp));
+  std::deque<std::pair<int64_t, Observation>> in_flight;  // (capture time, what the detector saw)
+  const int64_t latency_us = static_cast<int64_t>(latency_s * 1e6);
+  for (int i = 1; i <= ticks && session.running(); ++i) {
+    const int64_t t = kT0 + i * 10'000;
+    tcp = test::integrate(tcp, twist, 0.01);
+    take(session.on_arm_state(t, tcp, ArmCondition::kExecuting, ""));
+    if (i % 10 == 0) in_flight.emplace_back(t, capture(t, tcp));
+    while (!in_flight.empty() && in_flight.front().first + latency_us <= t) {
+      take(deliver(in_flight.front().first, in_flight.front().second));
+      in_flight.pop_front();
+    }
+  }
+  return {reports.back(), tcp};
+}
+
+/// The stripe servo with images `latency_s` late (run_with_late_images). Returns the final report and the TCP.
 std::pair<ServoReport, Eigen::Isometry3d> run_late_stripe(double latency_s, bool compensate) {
   const HandEyeGeometry geo = test::project_geometry();
   StripeEndServoParams sp;
@@ -262,33 +292,15 @@ std::pair<ServoReport, Eigen::Isometry3d> run_late_stripe(double latency_s, bool
   scene.books_z = 0.30;
   Eigen::Isometry3d tcp = Eigen::Isometry3d::Identity();
   tcp.translation() = Eigen::Vector3d(0.01, 0.30, 0.0);  // 15 cm right of the end: its left end is in view
-  std::vector<ServoReport> reports;
-  GripperTwist twist = GripperTwist::Zero();
-  auto take = [&](const SessionOutput& o) {
-    for (const auto& c : o.commands) twist = c.stop ? GripperTwist::Zero() : c.twist;
-    reports.insert(reports.end(), o.reports.begin(), o.reports.end());
-  };
-  take(session.on_arm_state(kT0, tcp, ArmCondition::kIdle, ""));
   ServoRequest r;
   r.utime = kT0;
   r.request_id = 9;
   r.mode = ServoMode::kStripeEnd;
   r.standoff_m = scene.board_z;
   r.timeout_s = 30;
-  take(session.on_request(r));
-  std::deque<std::pair<int64_t, StripeObservation>> in_flight;  // (capture time, what BSwH saw)
-  const int64_t latency_us = static_cast<int64_t>(latency_s * 1e6);
-  for (int i = 1; i <= 3100 && session.running(); ++i) {
-    const int64_t t = kT0 + i * 10'000;
-    tcp = test::integrate(tcp, twist, 0.01);
-    take(session.on_arm_state(t, tcp, ArmCondition::kExecuting, ""));
-    if (i % 10 == 0) in_flight.emplace_back(t, scene.observe(geo, tcp));
-    while (!in_flight.empty() && in_flight.front().first + latency_us <= t) {
-      take(session.on_stripe(in_flight.front().first, in_flight.front().second, ""));
-      in_flight.pop_front();
-    }
-  }
-  return {reports.back(), tcp};
+  return run_with_late_images(
+      session, tcp, r, latency_s, 3100, [&](int64_t, const Eigen::Isometry3d& at) { return scene.observe(geo, at); },
+      [&](int64_t t, const StripeObservation& o) { return session.on_stripe(t, o, ""); });
 }
 
 TEST(StripeServoLatency, ImagesASecondLateStillConvergeOnTheTrueEnd) {
@@ -305,9 +317,8 @@ TEST(StripeServoLatency, ImagesASecondLateStillConvergeOnTheTrueEnd) {
   EXPECT_NE(uncompensated.state, ServoState::kConverged) << "the test plant no longer shows the overshoot";
 }
 
-/// The corner servo closed through the session, images every 0.1 s reaching it `latency_s` after capture, arm states
-/// every 10 ms, the TCP following the last command; the corner 4 cm up and 3 cm right of the start, its top edge
-/// rolled 3 degrees. Returns the final report.
+/// The corner servo with images `latency_s` late (run_with_late_images); the corner 4 cm up and 3 cm right of the
+/// start, its top edge rolled 3 degrees. Returns the final report.
 ServoReport run_late_corner(double latency_s, bool compensate) {
   const HandEyeGeometry geo = test::project_geometry();
   BookCornerServoParams cp;
@@ -322,39 +333,21 @@ ServoReport run_late_corner(double latency_s, bool compensate) {
   test::CornerScene scene;
   scene.corner = Eigen::Vector3d(0.04, 0.03, 0.22);
   scene.roll_rad = 3.0 * M_PI / 180.0;
-  Eigen::Isometry3d tcp = Eigen::Isometry3d::Identity();
-  std::vector<ServoReport> reports;
-  GripperTwist twist = GripperTwist::Zero();
-  auto take = [&](const SessionOutput& o) {
-    for (const auto& c : o.commands) twist = c.stop ? GripperTwist::Zero() : c.twist;
-    reports.insert(reports.end(), o.reports.begin(), o.reports.end());
-  };
-  take(session.on_arm_state(kT0, tcp, ArmCondition::kIdle, ""));
   ServoRequest r;
   r.utime = kT0;
   r.request_id = 11;
   r.mode = ServoMode::kBookCorner;
   r.standoff_m = 0.22;
   r.timeout_s = 20;
-  take(session.on_request(r));
-  std::deque<BookObservation> in_flight;
-  const int64_t latency_us = static_cast<int64_t>(latency_s * 1e6);
-  for (int i = 1; i <= 2100 && session.running(); ++i) {
-    const int64_t t = kT0 + i * 10'000;
-    tcp = test::integrate(tcp, twist, 0.01);
-    take(session.on_arm_state(t, tcp, ArmCondition::kExecuting, ""));
-    if (i % 10 == 0) {
-      BookObservation o;
-      o.utime = t;
-      o.found = scene.observe(geo, tcp, &o.r_px, &o.slope_rad);
-      in_flight.push_back(o);
-    }
-    while (!in_flight.empty() && in_flight.front().utime + latency_us <= t) {
-      take(session.on_book(in_flight.front()));
-      in_flight.pop_front();
-    }
-  }
-  return reports.back();
+  const auto capture = [&](int64_t t, const Eigen::Isometry3d& at) {
+    BookObservation o;
+    o.utime = t;
+    o.found = scene.observe(geo, at, &o.r_px, &o.slope_rad);
+    return o;
+  };
+  return run_with_late_images(session, Eigen::Isometry3d::Identity(), r, latency_s, 2100, capture,
+                              [&](int64_t, const BookObservation& o) { return session.on_book(o); })
+      .first;
 }
 
 TEST(CornerServoLatency, ImagesASecondLateStillConvergeOnTheTrueCorner) {
