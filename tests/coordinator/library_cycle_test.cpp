@@ -115,17 +115,17 @@ TEST(LibraryCycle, ThreeBooksWholeCycleEveryTransitionAndPlacements) {
   EXPECT_EQ(cycle.status().state, "DONE");
   EXPECT_EQ(cycle.status().books_moved, 3);
 
-  // Lower shelf (coordinator.yaml lower_shelf: first_right_y 0.20, gap 0.005, front_z -0.03, drop 0.32): right covers
-  // at 0.20, 0.20 - 0.025 - 0.005 = 0.17, 0.17 - 0.020 - 0.005 = 0.145; TCP Y = right - BW/2;
-  // Z = -0.03 + 0.03 (insertion) = 0. Base = (0.60 + Z, -0.05 - Y, X). X: the book was taken from the holder
+  // Lower shelf (coordinator.yaml lower_shelf: first_right_y 0.10, gap 0.005, front_z -0.04, drop 0.32): right covers
+  // at 0.10, 0.10 - 0.025 - 0.005 = 0.07, 0.07 - 0.020 - 0.005 = 0.045; TCP Y = right - BW/2;
+  // Z = -0.04 + 0.03 (insertion) = -0.01. Base = (0.60 + Z, -0.05 - Y, X). X: the book was taken from the holder
   // with the TCP holder.regrasp_lower_m (0.015) lower than at its release, after it had dropped place_clearance_m
   // (0.005) onto the ledge, so the TCP is height - 0.015 + 0.005 above its bottom; the place leaves 0.005 below it:
   // X = -0.32 + (height - 0.015 + 0.005) + 0.005.
-  const double ys[3] = {0.20 - 0.0125, 0.17 - 0.010, 0.145 - 0.015};
+  const double ys[3] = {0.10 - 0.0125, 0.07 - 0.010, 0.045 - 0.015};
   const double hs[3] = {0.25, 0.18, 0.22};
   for (int i = 0; i < 3; ++i) {
     const Eigen::Vector3d tcp = w.lower[i].second.translation();
-    EXPECT_NEAR(tcp.x(), 0.60, 0.0015) << "book " << i;
+    EXPECT_NEAR(tcp.x(), 0.60 - 0.01, 0.0015) << "book " << i;
     EXPECT_NEAR(tcp.y(), -0.05 - ys[i], 0.0015) << "book " << i;
     EXPECT_NEAR(tcp.z(), -0.32 + hs[i] - 0.015 + 0.005 + 0.005, 0.0015) << "book " << i;
   }
