@@ -701,32 +701,41 @@ SegmentationResult segment_god(const cv::Mat& image, const cv::Mat& points, cons
   recent.assign(size_t(1) << kCacheBits, 0);  // 0 never is an edge (labels >= 1)
   // Without branches on the data (their outcomes are close to random here): the edge is always
   // written and counted only if it is new to the cache and not a pair of one segment.
-  size_t num_edges = 0;
+  uint64_t* out = edges.data();
+  uint64_t* out_end = out + edges.size();
+  uint64_t* const cache = recent.data();
   const auto push = [&](int a, int b) {
     const uint64_t lo = uint64_t(std::min(a, b)), hi = uint64_t(std::max(a, b));
     const uint64_t e = (lo << 32) | hi;
-    uint64_t& slot = recent[size_t((e * 0x9E3779B97F4A7C15ull) >> (64 - kCacheBits))];
+    uint64_t& slot = cache[size_t((e * 0x9E3779B97F4A7C15ull) >> (64 - kCacheBits))];
     const uint64_t old = slot;
     const bool fresh = (old != e) & (a != b);
-    edges[num_edges] = e;
-    num_edges += size_t(fresh);
+    *out = e;
+    out += fresh;
     slot = fresh ? e : old;
-    if (num_edges == edges.size()) edges.resize(2 * edges.size());
+    if (out == out_end) {
+      const size_t n = edges.size();
+      edges.resize(2 * n);
+      out = edges.data() + n;
+      out_end = edges.data() + edges.size();
+    }
   };
+  const Run* const rn = runs.data();
   for (int y = 0; y < H; ++y) {
     const size_t i0 = row_start[size_t(y)], i1 = row_start[size_t(y) + 1];
     for (size_t i = i0; i < i1; ++i)
-      for (size_t k = i + 1; k < i1 && runs[k].x0 - runs[i].x1 <= R; ++k) push(runs[i].label, runs[k].label);
+      for (size_t k = i + 1; k < i1 && rn[k].x0 - rn[i].x1 <= R; ++k) push(rn[i].label, rn[k].label);
     for (int dy = 1; dy <= R && y + dy < H; ++dy) {
       size_t j = row_start[size_t(y + dy)];
       const size_t j1 = row_start[size_t(y + dy) + 1];
       for (size_t i = i0; i < i1; ++i) {
-        const Run& u = runs[i];
-        while (j < j1 && runs[j].x1 < u.x0 - R) ++j;  // u.x0 grows with i: j only moves forward
-        for (size_t k = j; k < j1 && runs[k].x0 <= u.x1 + R; ++k) push(u.label, runs[k].label);
+        const Run u = rn[i];
+        while (j < j1 && rn[j].x1 < u.x0 - R) ++j;  // u.x0 grows with i: j only moves forward
+        for (size_t k = j; k < j1 && rn[k].x0 <= u.x1 + R; ++k) push(u.label, rn[k].label);
       }
     }
   }
+  const size_t num_edges = size_t(out - edges.data());
   edges.resize(num_edges);
   std::vector<uint64_t>& edge_tmp = ws.edge_tmp;
   std::vector<int>&edge_start = ws.edge_start, &edge_stamp = ws.edge_stamp;
