@@ -390,6 +390,40 @@ inline int hist_argmax(const Count8* h, int K) {
   }
   return 0;
 }
+/// One row of the voting with 8-bit counts and 32 lanes (up to 32 bins): the window's histogram is
+/// held in two registers (h0: lanes 0-15, h1: 16-31); the same sums and the same argmax (largest
+/// count, lowest bin on ties) as hist_add / hist_sub / hist_argmax. `col`: W column histograms of 32.
+inline void vote_row_32(const uint8_t* b, uint8_t* o, const uint8_t* col, int W, int r, int num_bins) {
+  const auto ld = [&](int x, int half) {
+    return _mm_loadu_si128(reinterpret_cast<const __m128i*>(col + size_t(x) * 32 + size_t(half) * 16));
+  };
+  __m128i h0 = _mm_setzero_si128(), h1 = _mm_setzero_si128();
+  for (int x = 0; x <= std::min(r, W - 1); ++x) {
+    h0 = _mm_add_epi8(h0, ld(x, 0));
+    h1 = _mm_add_epi8(h1, ld(x, 1));
+  }
+  for (int x = 0; x < W; ++x) {
+    if (b[x] < num_bins) {
+      __m128i mx = _mm_max_epu8(h0, h1);
+      mx = _mm_max_epu8(mx, _mm_shuffle_epi32(mx, _MM_SHUFFLE(1, 0, 3, 2)));
+      mx = _mm_max_epu8(mx, _mm_shuffle_epi32(mx, _MM_SHUFFLE(2, 3, 0, 1)));
+      mx = _mm_max_epu8(mx,
+                        _mm_shufflelo_epi16(_mm_shufflehi_epi16(mx, _MM_SHUFFLE(2, 3, 0, 1)), _MM_SHUFFLE(2, 3, 0, 1)));
+      mx = _mm_max_epu8(mx, _mm_or_si128(_mm_srli_epi16(mx, 8), _mm_slli_epi16(mx, 8)));  // every lane: the max
+      const unsigned m = unsigned(_mm_movemask_epi8(_mm_cmpeq_epi8(h0, mx))) |
+                         (unsigned(_mm_movemask_epi8(_mm_cmpeq_epi8(h1, mx))) << 16);
+      o[x] = uint8_t(__builtin_ctz(m));
+    }
+    if (x + r + 1 < W) {
+      h0 = _mm_add_epi8(h0, ld(x + r + 1, 0));
+      h1 = _mm_add_epi8(h1, ld(x + r + 1, 1));
+    }
+    if (x - r >= 0) {
+      h0 = _mm_sub_epi8(h0, ld(x - r, 0));
+      h1 = _mm_sub_epi8(h1, ld(x - r, 1));
+    }
+  }
+}
 #else
 template <typename C>
 inline void hist_add(C* h, const C* c, int K) {
@@ -441,10 +475,16 @@ void vote_clusters_into(const cv::Mat& bins, int num_bins, int n, cv::Mat& out, 
       if (y + r < H) col_update(y + r, +1);
       if (y - r - 1 >= 0) col_update(y - r - 1, -1);
     }
-    std::fill(hist, hist + K, Count(0));
-    for (int x = 0; x <= std::min(r, W - 1); ++x) hist_add(hist, &col[size_t(x) * size_t(K)], K);
     const uint8_t* b = bins.ptr<uint8_t>(y);
     uint8_t* o = out.ptr<uint8_t>(y);
+#if defined(__SSE2__)
+    if (sizeof(C) == 1 && K == 32) {  // the usual 17 bins: the histogram stays in two registers
+      vote_row_32(b, o, reinterpret_cast<const uint8_t*>(col.data()), W, r, num_bins);
+      continue;
+    }
+#endif
+    std::fill(hist, hist + K, Count(0));
+    for (int x = 0; x <= std::min(r, W - 1); ++x) hist_add(hist, &col[size_t(x) * size_t(K)], K);
     for (int x = 0; x < W; ++x) {
       if (b[x] < num_bins) o[x] = uint8_t(hist_argmax(hist, K));
       if (x + r + 1 < W) hist_add(hist, &col[size_t(x + r + 1) * size_t(K)], K);
