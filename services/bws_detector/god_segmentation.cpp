@@ -105,6 +105,71 @@ struct Sums {
   }
 };
 
+inline bool finite3(const cv::Vec3f& q) {
+  return std::isfinite(q[0]) && std::isfinite(q[1]) && std::isfinite(q[2]);
+}
+
+static_assert(sizeof(Sums) == 10 * sizeof(double), "Sums: ten contiguous doubles");
+
+#if defined(__SSE2__)
+/// Sums::add of (px, py, pz) on five pairs of lanes [n, x] [y, z] [xx, xy] [xz, yy] [yz, zz]: every lane
+/// makes the scalar code's operation (IEEE double, no fused multiply-add), so the sums are the same bits.
+struct PackedSums {
+  __m128d nx, yz, xx_xy, xz_yy, yz_zz;
+  explicit PackedSums(const Sums& s)
+      : nx(_mm_loadu_pd(&s.n)),
+        yz(_mm_loadu_pd(&s.y)),
+        xx_xy(_mm_loadu_pd(&s.xx)),
+        xz_yy(_mm_loadu_pd(&s.xz)),
+        yz_zz(_mm_loadu_pd(&s.yz)) {}
+  void store(Sums& s) const {
+    _mm_storeu_pd(&s.n, nx);
+    _mm_storeu_pd(&s.y, yz);
+    _mm_storeu_pd(&s.xx, xx_xy);
+    _mm_storeu_pd(&s.xz, xz_yy);
+    _mm_storeu_pd(&s.yz, yz_zz);
+  }
+  /// one_x = [1, px], pyz = [py, pz].
+  void add(__m128d one_x, __m128d pyz) {
+    const __m128d px2 = _mm_unpackhi_pd(one_x, one_x);  // [px, px]
+    const __m128d pxy = _mm_shuffle_pd(one_x, pyz, 1);  // [px, py]
+    const __m128d pzy = _mm_shuffle_pd(pyz, pyz, 1);    // [pz, py]
+    const __m128d pz2 = _mm_unpackhi_pd(pyz, pyz);      // [pz, pz]
+    nx = _mm_add_pd(nx, one_x);
+    yz = _mm_add_pd(yz, pyz);
+    xx_xy = _mm_add_pd(xx_xy, _mm_mul_pd(px2, pxy));  // [px*px, px*py]
+    xz_yy = _mm_add_pd(xz_yy, _mm_mul_pd(pxy, pzy));  // [px*pz, py*py]
+    yz_zz = _mm_add_pd(yz_zz, _mm_mul_pd(pyz, pz2));  // [py*pz, pz*pz]
+  }
+};
+#endif
+
+/// Adds the merge-space points (x, y, v[x]) of the valid pixels x0..x1 of row y to `s` (Sums::add, in order).
+inline void add_image_run(Sums& s, const float* v, int x0, int x1, int y) {
+#if defined(__SSE2__)
+  PackedSums p(s);
+  for (int x = x0; x <= x1; ++x)
+    if (valid_value(v[x])) p.add(_mm_set_pd(double(x), 1.0), _mm_set_pd(double(v[x]), double(y)));
+  p.store(s);
+#else
+  for (int x = x0; x <= x1; ++x)
+    if (valid_value(v[x])) s.add(double(x), double(y), double(v[x]));
+#endif
+}
+
+/// Adds the finite points q[x0..x1] to `s` (Sums::add, in order).
+inline void add_point_run(Sums& s, const cv::Vec3f* q, int x0, int x1) {
+#if defined(__SSE2__)
+  PackedSums p(s);
+  for (int x = x0; x <= x1; ++x)
+    if (finite3(q[x])) p.add(_mm_set_pd(double(q[x][0]), 1.0), _mm_set_pd(double(q[x][2]), double(q[x][1])));
+  p.store(s);
+#else
+  for (int x = x0; x <= x1; ++x)
+    if (finite3(q[x])) s.add(q[x][0], q[x][1], q[x][2]);
+#endif
+}
+
 /// The merge's plane of a segment: fit_plane(s.moments()) with the covariance's eigenvectors from
 /// Eigen's closed-form 3x3 solver (analytic eigenvalues, eigenvectors from cross products of rows)
 /// instead of its iterative one: ~5x cheaper; the normal can differ from fit_plane's in the last bits.
@@ -130,10 +195,6 @@ Plane fit_plane_closed_form(const Sums& s) {
   plane.offset = n.dot(mean);
   plane.valid = true;
   return plane;
-}
-
-inline bool finite3(const cv::Vec3f& q) {
-  return std::isfinite(q[0]) && std::isfinite(q[1]) && std::isfinite(q[2]);
 }
 
 /// Removes repeated edges (lo << 32 | hi, 1 <= lo < hi <= count) in O(E + count) by a counting sort on
@@ -710,21 +771,11 @@ SegmentationResult segment_god(const cv::Mat& image, const cv::Mat& points, cons
     const cv::Vec3f* q = points.empty() ? nullptr : points.ptr<cv::Vec3f>(y);
     for (size_t i = row_start[size_t(y)]; i < row_start[size_t(y) + 1]; ++i) {
       const Run& r = runs[i];
-      Sums m = mom[size_t(r.label)];
-      if (image_space) {
-        for (int x = r.x0; x <= r.x1; ++x)
-          if (valid_value(v[x])) m.add(double(x), double(y), double(v[x]));
-      } else {
-        for (int x = r.x0; x <= r.x1; ++x)
-          if (finite3(q[x])) m.add(q[x][0], q[x][1], q[x][2]);
-      }
-      mom[size_t(r.label)] = m;
-      if (!same) {
-        Sums o = omom[size_t(r.label)];
-        for (int x = r.x0; x <= r.x1; ++x)
-          if (finite3(q[x])) o.add(q[x][0], q[x][1], q[x][2]);
-        omom[size_t(r.label)] = o;
-      }
+      if (image_space)
+        add_image_run(mom[size_t(r.label)], v, r.x0, r.x1, y);
+      else
+        add_point_run(mom[size_t(r.label)], q, r.x0, r.x1);
+      if (!same) add_point_run(omom[size_t(r.label)], q, r.x0, r.x1);
     }
   }
 
