@@ -201,7 +201,10 @@ BookFrontResult select_book_front(const SegmentationResult& seg, const cv::Mat& 
       if (l[x] > 0 && size_t(l[x]) <= K && point_ok(q[x])) ++first[size_t(l[x]) + 1];
   }
   for (size_t i = 1; i < first.size(); ++i) first[i] += first[i - 1];
-  std::vector<Eigen::Vector3f> box_pts(first[K + 1]);
+  // The large scratch buffers are per thread and keep their capacity across frames (no fresh pages per
+  // frame); each is sized and filled per call as before.
+  thread_local std::vector<Eigen::Vector3f> box_pts;
+  box_pts.resize(first[K + 1]);
   {
     std::vector<size_t> fill(first.begin(), first.end() - 1);
     for (int y = 0; y < seg.labels.rows; ++y) {
@@ -225,10 +228,12 @@ BookFrontResult select_book_front(const SegmentationResult& seg, const cv::Mat& 
   double best_y = std::numeric_limits<double>::infinity();
   // Depth along the rear-board normal (box x) of every pixel, for splitting wide regions.
   // Computed when the first wide region needs it.
+  thread_local cv::Mat rear_depth_buffer;
   cv::Mat rear_depth;
   const auto make_rear_depth = [&]() {
     if (!rear_depth.empty()) return;
-    rear_depth.create(seg.labels.size(), CV_32F);
+    rear_depth_buffer.create(seg.labels.size(), CV_32F);
+    rear_depth = rear_depth_buffer;
     rear_depth.setTo(cv::Scalar(std::numeric_limits<float>::quiet_NaN()));
     for (int y = 0; y < seg.labels.rows; ++y) {
       const cv::Vec3f* q = points_camera.ptr<cv::Vec3f>(y);
@@ -238,7 +243,7 @@ BookFrontResult select_book_front(const SegmentationResult& seg, const cv::Mat& 
     }
   };
   std::vector<std::pair<int, int>> band_of(K + 1, {-1, -1});
-  std::vector<double> c[3], b1, b2;  // per region: base coordinates, box y and z of its points
+  thread_local std::vector<double> c[3], b1, b2;  // per region: base coordinates, box y and z of its points
   for (const PlaneRegion& r : seg.regions) {
     RegionVerdict v;
     v.label = r.label;
@@ -355,7 +360,9 @@ BookFrontResult select_book_front(const SegmentationResult& seg, const cv::Mat& 
     out.split = true;
     out.band_x0 = band_of[size_t(best)].first;
     out.band_x1 = band_of[size_t(best)].second;
-    cv::Mat band(seg.labels.size(), CV_32S, cv::Scalar(0));
+    thread_local cv::Mat band;
+    band.create(seg.labels.size(), CV_32S);
+    band.setTo(cv::Scalar(0));
     std::vector<double> offs;
     for (int y = r.bbox.y; y < r.bbox.y + r.bbox.height; ++y) {
       const int* l = seg.labels.ptr<int>(y);

@@ -105,6 +105,71 @@ struct Sums {
   }
 };
 
+inline bool finite3(const cv::Vec3f& q) {
+  return std::isfinite(q[0]) && std::isfinite(q[1]) && std::isfinite(q[2]);
+}
+
+static_assert(sizeof(Sums) == 10 * sizeof(double), "Sums: ten contiguous doubles");
+
+#if defined(__SSE2__)
+/// Sums::add of (px, py, pz) on five pairs of lanes [n, x] [y, z] [xx, xy] [xz, yy] [yz, zz]: every lane
+/// makes the scalar code's operation (IEEE double, no fused multiply-add), so the sums are the same bits.
+struct PackedSums {
+  __m128d nx, yz, xx_xy, xz_yy, yz_zz;
+  explicit PackedSums(const Sums& s)
+      : nx(_mm_loadu_pd(&s.n)),
+        yz(_mm_loadu_pd(&s.y)),
+        xx_xy(_mm_loadu_pd(&s.xx)),
+        xz_yy(_mm_loadu_pd(&s.xz)),
+        yz_zz(_mm_loadu_pd(&s.yz)) {}
+  void store(Sums& s) const {
+    _mm_storeu_pd(&s.n, nx);
+    _mm_storeu_pd(&s.y, yz);
+    _mm_storeu_pd(&s.xx, xx_xy);
+    _mm_storeu_pd(&s.xz, xz_yy);
+    _mm_storeu_pd(&s.yz, yz_zz);
+  }
+  /// one_x = [1, px], pyz = [py, pz].
+  void add(__m128d one_x, __m128d pyz) {
+    const __m128d px2 = _mm_unpackhi_pd(one_x, one_x);  // [px, px]
+    const __m128d pxy = _mm_shuffle_pd(one_x, pyz, 1);  // [px, py]
+    const __m128d pzy = _mm_shuffle_pd(pyz, pyz, 1);    // [pz, py]
+    const __m128d pz2 = _mm_unpackhi_pd(pyz, pyz);      // [pz, pz]
+    nx = _mm_add_pd(nx, one_x);
+    yz = _mm_add_pd(yz, pyz);
+    xx_xy = _mm_add_pd(xx_xy, _mm_mul_pd(px2, pxy));  // [px*px, px*py]
+    xz_yy = _mm_add_pd(xz_yy, _mm_mul_pd(pxy, pzy));  // [px*pz, py*py]
+    yz_zz = _mm_add_pd(yz_zz, _mm_mul_pd(pyz, pz2));  // [py*pz, pz*pz]
+  }
+};
+#endif
+
+/// Adds the merge-space points (x, y, v[x]) of the valid pixels x0..x1 of row y to `s` (Sums::add, in order).
+inline void add_image_run(Sums& s, const float* v, int x0, int x1, int y) {
+#if defined(__SSE2__)
+  PackedSums p(s);
+  for (int x = x0; x <= x1; ++x)
+    if (valid_value(v[x])) p.add(_mm_set_pd(double(x), 1.0), _mm_set_pd(double(v[x]), double(y)));
+  p.store(s);
+#else
+  for (int x = x0; x <= x1; ++x)
+    if (valid_value(v[x])) s.add(double(x), double(y), double(v[x]));
+#endif
+}
+
+/// Adds the finite points q[x0..x1] to `s` (Sums::add, in order).
+inline void add_point_run(Sums& s, const cv::Vec3f* q, int x0, int x1) {
+#if defined(__SSE2__)
+  PackedSums p(s);
+  for (int x = x0; x <= x1; ++x)
+    if (finite3(q[x])) p.add(_mm_set_pd(double(q[x][0]), 1.0), _mm_set_pd(double(q[x][2]), double(q[x][1])));
+  p.store(s);
+#else
+  for (int x = x0; x <= x1; ++x)
+    if (finite3(q[x])) s.add(q[x][0], q[x][1], q[x][2]);
+#endif
+}
+
 /// The merge's plane of a segment: fit_plane(s.moments()) with the covariance's eigenvectors from
 /// Eigen's closed-form 3x3 solver (analytic eigenvalues, eigenvectors from cross products of rows)
 /// instead of its iterative one: ~5x cheaper; the normal can differ from fit_plane's in the last bits.
@@ -130,10 +195,6 @@ Plane fit_plane_closed_form(const Sums& s) {
   plane.offset = n.dot(mean);
   plane.valid = true;
   return plane;
-}
-
-inline bool finite3(const cv::Vec3f& q) {
-  return std::isfinite(q[0]) && std::isfinite(q[1]) && std::isfinite(q[2]);
 }
 
 /// Removes repeated edges (lo << 32 | hi, 1 <= lo < hi <= count) in O(E + count) by a counting sort on
@@ -390,6 +451,40 @@ inline int hist_argmax(const Count8* h, int K) {
   }
   return 0;
 }
+/// One row of the voting with 8-bit counts and 32 lanes (up to 32 bins): the window's histogram is
+/// held in two registers (h0: lanes 0-15, h1: 16-31); the same sums and the same argmax (largest
+/// count, lowest bin on ties) as hist_add / hist_sub / hist_argmax. `col`: W column histograms of 32.
+inline void vote_row_32(const uint8_t* b, uint8_t* o, const uint8_t* col, int W, int r, int num_bins) {
+  const auto ld = [&](int x, int half) {
+    return _mm_loadu_si128(reinterpret_cast<const __m128i*>(col + size_t(x) * 32 + size_t(half) * 16));
+  };
+  __m128i h0 = _mm_setzero_si128(), h1 = _mm_setzero_si128();
+  for (int x = 0; x <= std::min(r, W - 1); ++x) {
+    h0 = _mm_add_epi8(h0, ld(x, 0));
+    h1 = _mm_add_epi8(h1, ld(x, 1));
+  }
+  for (int x = 0; x < W; ++x) {
+    if (b[x] < num_bins) {
+      __m128i mx = _mm_max_epu8(h0, h1);
+      mx = _mm_max_epu8(mx, _mm_shuffle_epi32(mx, _MM_SHUFFLE(1, 0, 3, 2)));
+      mx = _mm_max_epu8(mx, _mm_shuffle_epi32(mx, _MM_SHUFFLE(2, 3, 0, 1)));
+      mx = _mm_max_epu8(mx,
+                        _mm_shufflelo_epi16(_mm_shufflehi_epi16(mx, _MM_SHUFFLE(2, 3, 0, 1)), _MM_SHUFFLE(2, 3, 0, 1)));
+      mx = _mm_max_epu8(mx, _mm_or_si128(_mm_srli_epi16(mx, 8), _mm_slli_epi16(mx, 8)));  // every lane: the max
+      const unsigned m = unsigned(_mm_movemask_epi8(_mm_cmpeq_epi8(h0, mx))) |
+                         (unsigned(_mm_movemask_epi8(_mm_cmpeq_epi8(h1, mx))) << 16);
+      o[x] = uint8_t(__builtin_ctz(m));
+    }
+    if (x + r + 1 < W) {
+      h0 = _mm_add_epi8(h0, ld(x + r + 1, 0));
+      h1 = _mm_add_epi8(h1, ld(x + r + 1, 1));
+    }
+    if (x - r >= 0) {
+      h0 = _mm_sub_epi8(h0, ld(x - r, 0));
+      h1 = _mm_sub_epi8(h1, ld(x - r, 1));
+    }
+  }
+}
 #else
 template <typename C>
 inline void hist_add(C* h, const C* c, int K) {
@@ -441,10 +536,16 @@ void vote_clusters_into(const cv::Mat& bins, int num_bins, int n, cv::Mat& out, 
       if (y + r < H) col_update(y + r, +1);
       if (y - r - 1 >= 0) col_update(y - r - 1, -1);
     }
-    std::fill(hist, hist + K, Count(0));
-    for (int x = 0; x <= std::min(r, W - 1); ++x) hist_add(hist, &col[size_t(x) * size_t(K)], K);
     const uint8_t* b = bins.ptr<uint8_t>(y);
     uint8_t* o = out.ptr<uint8_t>(y);
+#if defined(__SSE2__)
+    if (sizeof(C) == 1 && K == 32) {  // the usual 17 bins: the histogram stays in two registers
+      vote_row_32(b, o, reinterpret_cast<const uint8_t*>(col.data()), W, r, num_bins);
+      continue;
+    }
+#endif
+    std::fill(hist, hist + K, Count(0));
+    for (int x = 0; x <= std::min(r, W - 1); ++x) hist_add(hist, &col[size_t(x) * size_t(K)], K);
     for (int x = 0; x < W; ++x) {
       if (b[x] < num_bins) o[x] = uint8_t(hist_argmax(hist, K));
       if (x + r + 1 < W) hist_add(hist, &col[size_t(x + r + 1) * size_t(K)], K);
@@ -453,52 +554,97 @@ void vote_clusters_into(const cv::Mat& bins, int num_bins, int n, cv::Mat& out, 
   }
 }
 
-/// connected_regions into `lab` (its buffer reused when it has the size and type), with the union-find
-/// and the renumbering in `uf` and `remap` (capacity reused).
-void connected_regions_into(const cv::Mat& cls, int* count, cv::Mat& lab, UnionFind& uf, std::vector<int>& remap) {
+/// A maximal horizontal run of one initial segment in a row: columns x0..x1 of segment `label`.
+struct Run {
+  int x0, x1, label;
+};
+
+/// Runs of the initial segments, in raster order: `runs[row_start[y]] .. runs[row_start[y + 1] - 1]`
+/// are the runs of row y (row_start has H + 1 entries).
+struct RunImage {
+  std::vector<Run> runs;
+  std::vector<size_t> row_start;
+};
+
+/// Last column of the run of `c[x]`'s value that starts at x (the row has W pixels).
+inline int run_end(const uint8_t* c, int x, int W) {
+  const uint8_t v = c[x];
+  int x1 = x + 1;
+#if defined(__SSE2__)
+  const __m128i vv = _mm_set1_epi8(char(v));
+  for (; x1 + 16 <= W; x1 += 16) {
+    const unsigned m =
+        unsigned(_mm_movemask_epi8(_mm_cmpeq_epi8(_mm_loadu_si128(reinterpret_cast<const __m128i*>(c + x1)), vv)));
+    if (m != 0xffffu) return x1 + __builtin_ctz(~m) - 1;
+  }
+#endif
+  while (x1 < W && c[x1] == v) ++x1;
+  return x1 - 1;
+}
+
+/// 4-connected components of equal values of `cls` (CV_8U, 255 = background) as runs: the runs of each
+/// row, joined to the runs of the row above that share a column and the value (union-find on runs),
+/// labelled 1..count in raster order of the components' first pixels (= of their first runs).
+/// `uf`, `remap` and `values` are scratch (capacity reused).
+void connected_runs(const cv::Mat& cls, RunImage& ri, int* count, UnionFind& uf, std::vector<int>& remap,
+                    std::vector<uint8_t>& values) {
   if (cls.type() != CV_8U) throw std::invalid_argument("connected_regions: input must be CV_8U");
   const int W = cls.cols, H = cls.rows;
-  lab.create(cls.size(), CV_32S);
-  lab.setTo(cv::Scalar(0));
-  uf.reset(1);
-  uf.parent.reserve(size_t(W) * size_t(H) / 4 + 16);
-  int next = 1;
+  std::vector<Run>& runs = ri.runs;
+  runs.clear();
+  values.clear();
+  uf.parent.clear();
+  ri.row_start.resize(size_t(H) + 1);
   for (int y = 0; y < H; ++y) {
+    const size_t i0 = runs.size();
+    ri.row_start[size_t(y)] = i0;
     const uint8_t* c = cls.ptr<uint8_t>(y);
-    const uint8_t* cu = y > 0 ? cls.ptr<uint8_t>(y - 1) : nullptr;
-    int* l = lab.ptr<int>(y);
-    const int* lu = y > 0 ? lab.ptr<int>(y - 1) : nullptr;
-    for (int x = 0; x < W; ++x) {
-      const uint8_t v = c[x];
-      if (v == 255) continue;
-      const bool left = x > 0 && c[x - 1] == v;
-      const bool up = cu && cu[x] == v;
-      if (left && up) {
-        l[x] = l[x - 1];
-        if (lu[x] != l[x - 1]) uf.unite(lu[x], l[x - 1]);
-      } else if (left) {
-        l[x] = l[x - 1];
-      } else if (up) {
-        l[x] = lu[x];
-      } else {
-        l[x] = next++;
-        uf.parent.push_back(l[x]);
+    for (int x = 0; x < W;) {
+      const int x1 = run_end(c, x, W);
+      if (c[x] != 255) {
+        const int id = int(runs.size());
+        runs.push_back({x, x1, id});
+        values.push_back(c[x]);
+        uf.parent.push_back(id);
       }
+      x = x1 + 1;
+    }
+    if (y == 0) continue;
+    // Runs of the row above that share a column (4-neighbours); both lists are sorted by column.
+    size_t j = ri.row_start[size_t(y) - 1];
+    for (size_t i = i0; i < runs.size(); ++i) {
+      while (j < i0 && runs[j].x1 < runs[i].x0) ++j;
+      for (size_t k = j; k < i0 && runs[k].x0 <= runs[i].x1; ++k)
+        if (values[k] == values[i]) uf.unite(int(k), int(i));
     }
   }
+  ri.row_start[size_t(H)] = runs.size();
   // Compact numbering in raster order of first occurrence.
-  remap.assign(size_t(next), 0);
+  remap.assign(runs.size(), 0);
   int k = 0;
-  for (int y = 0; y < H; ++y) {
-    int* l = lab.ptr<int>(y);
-    for (int x = 0; x < W; ++x) {
-      if (l[x] == 0) continue;
-      const int root = uf.find(l[x]);
-      if (remap[size_t(root)] == 0) remap[size_t(root)] = ++k;
-      l[x] = remap[size_t(root)];
-    }
+  for (size_t i = 0; i < runs.size(); ++i) {
+    const int root = uf.find(int(i));
+    if (remap[size_t(root)] == 0) remap[size_t(root)] = ++k;
+    runs[i].label = remap[size_t(root)];
   }
   if (count) *count = k;
+}
+
+/// Writes the label image of `ri` (CV_32S, `size`; 0 outside the runs): a run's pixels get
+/// `id[run.label]`, or run.label itself when `id` is null.
+void paint_runs(const RunImage& ri, cv::Size size, const int* id, cv::Mat& lab) {
+  lab.create(size, CV_32S);
+  for (int y = 0; y < size.height; ++y) {
+    int* l = lab.ptr<int>(y);
+    int x = 0;
+    for (size_t i = ri.row_start[size_t(y)]; i < ri.row_start[size_t(y) + 1]; ++i) {
+      const Run& r = ri.runs[i];
+      std::fill(l + x, l + r.x0, 0);
+      std::fill(l + r.x0, l + r.x1 + 1, id ? id[r.label] : r.label);
+      x = r.x1 + 1;
+    }
+    std::fill(l + x, l + size.width, 0);
+  }
 }
 
 }  // namespace
@@ -511,10 +657,13 @@ cv::Mat vote_clusters(const cv::Mat& bins, int num_bins, int n) {
 }
 
 cv::Mat connected_regions(const cv::Mat& cls, int* count) {
-  cv::Mat lab;
+  RunImage ri;
   UnionFind uf;
   std::vector<int> remap;
-  connected_regions_into(cls, count, lab, uf, remap);
+  std::vector<uint8_t> values;
+  connected_runs(cls, ri, count, uf, remap, values);
+  cv::Mat lab;
+  paint_runs(ri, cls.size(), nullptr, lab);
   return lab;
 }
 
@@ -529,12 +678,9 @@ struct GodWorkspace {
   std::vector<Count8> col8;
   UnionFind cc_uf, uf;
   std::vector<int> remap;
+  std::vector<uint8_t> run_values;
   std::vector<Sums> mom, omom;
-  struct Run {
-    int x0, x1, label;
-  };
-  std::vector<Run> runs;
-  std::vector<size_t> row_start;
+  RunImage ri;
   std::vector<uint64_t> edges, recent, edge_tmp, root_edges;
   std::vector<int> edge_start, edge_stamp;
   std::vector<Plane> planes, oplanes;
@@ -569,7 +715,7 @@ SegmentationResult segment_god(const cv::Mat& image, const cv::Mat& points, cons
   // Images: the debug output's own (fresh) images, else the workspace's.
   cv::Mat& bins = debug ? dbg.bins : own(ws.bins);
   cv::Mat& clusters = debug ? dbg.clusters : own(ws.clusters);
-  cv::Mat& init_labels = debug ? dbg.initial_labels : own(ws.labels);
+  cv::Mat& init_labels = debug ? dbg.initial_labels : own(ws.labels);  // without debug: the merged labels' buffer
   if (debug) {
     dbg.features = compute_god_features(image, params.gradient_step, params.flat_mgod_max);
     dbg.bins = god_bins(dbg.features, params.direction_bins, params.jump_mgod_min);
@@ -584,11 +730,16 @@ SegmentationResult segment_god(const cv::Mat& image, const cv::Mat& points, cons
     vote_clusters_into(bins, params.direction_bins + 1, params.window_size, clusters, ws.col8);
   else
     vote_clusters_into(bins, params.direction_bins + 1, params.window_size, clusters, ws.col);
+  // Initial segments as runs (the label image of the initial segments is painted for the debug output
+  // only: the moments, the adjacency and the merged labels all work on the runs).
   int count = 0;
-  connected_regions_into(clusters, &count, init_labels, ws.cc_uf, ws.remap);
+  RunImage& ri = ws.ri;
+  connected_runs(clusters, ri, &count, ws.cc_uf, ws.remap, ws.run_values);
+  if (debug) paint_runs(ri, clusters.size(), nullptr, init_labels);
   dbg.initial_count = count;
-  const cv::Mat& init = init_labels;
   const int W = image.cols, H = image.rows;
+  const std::vector<Run>& runs = ri.runs;
+  const std::vector<size_t>& row_start = ri.row_start;
 
   // Merge-space point of a pixel: (x, y, value) in image space (no (x, y, value) image is built), else
   // the caller's point. The output planes are fitted to the caller's points, or to (x, y, value).
@@ -613,19 +764,18 @@ SegmentationResult segment_god(const cv::Mat& image, const cv::Mat& points, cons
   mom.assign(size_t(count) + 1, Sums());
   if (!same) ws.omom.assign(size_t(count) + 1, Sums());
   std::vector<Sums>& omom = same ? mom : ws.omom;
+  // Run by run: a run's pixels are consecutive in its segment's raster order, so its sums are added
+  // pixel by pixel into a local copy (the same additions in the same order, kept in registers).
   for (int y = 0; y < H; ++y) {
-    const int* l = init.ptr<int>(y);
     const float* v = image.ptr<float>(y);
     const cv::Vec3f* q = points.empty() ? nullptr : points.ptr<cv::Vec3f>(y);
-    for (int x = 0; x < W; ++x) {
-      const int lab = l[x];
-      if (lab <= 0) continue;
-      if (image_space) {
-        if (valid_value(v[x])) mom[size_t(lab)].add(double(x), double(y), double(v[x]));
-      } else if (finite3(q[x])) {
-        mom[size_t(lab)].add(q[x][0], q[x][1], q[x][2]);
-      }
-      if (!same && finite3(q[x])) omom[size_t(lab)].add(q[x][0], q[x][1], q[x][2]);
+    for (size_t i = row_start[size_t(y)]; i < row_start[size_t(y) + 1]; ++i) {
+      const Run& r = runs[i];
+      if (image_space)
+        add_image_run(mom[size_t(r.label)], v, r.x0, r.x1, y);
+      else
+        add_point_run(mom[size_t(r.label)], q, r.x0, r.x1);
+      if (!same) add_point_run(omom[size_t(r.label)], q, r.x0, r.x1);
     }
   }
 
@@ -635,54 +785,49 @@ SegmentationResult segment_god(const cv::Mat& image, const cv::Mat& points, cons
   // widened by R. An edge is not pushed again while it is in a small direct-mapped cache of recent
   // edges (most repeats come from the next rows); the rest of the repeats go in unique_edges.
   const int R = params.adjacency_radius_px;
-  using Run = GodWorkspace::Run;
-  std::vector<Run>& runs = ws.runs;
-  runs.clear();
-  runs.reserve(size_t(count) * 8);
-  std::vector<size_t>& row_start = ws.row_start;
-  row_start.resize(size_t(H) + 1);
-  for (int y = 0; y < H; ++y) {
-    row_start[size_t(y)] = runs.size();
-    const int* l = init.ptr<int>(y);
-    for (int x = 0; x < W;) {
-      const int a = l[x];
-      int x1 = x;
-      while (x1 + 1 < W && l[x1 + 1] == a) ++x1;
-      if (a != 0) runs.push_back({x, x1, a});
-      x = x1 + 1;
-    }
-  }
-  row_start[size_t(H)] = runs.size();
   std::vector<uint64_t>& edges = ws.edges;
-  edges.clear();
-  edges.reserve(size_t(count) * 4);
+  edges.resize(std::max(edges.capacity(), size_t(count) * 4 + 64));
   constexpr int kCacheBits = 11;
   std::vector<uint64_t>& recent = ws.recent;
   recent.assign(size_t(1) << kCacheBits, 0);  // 0 never is an edge (labels >= 1)
+  // Without branches on the data (their outcomes are close to random here): the edge is always
+  // written and counted only if it is new to the cache and not a pair of one segment.
+  uint64_t* out = edges.data();
+  uint64_t* out_end = out + edges.size();
+  uint64_t* const cache = recent.data();
   const auto push = [&](int a, int b) {
     const uint64_t lo = uint64_t(std::min(a, b)), hi = uint64_t(std::max(a, b));
     const uint64_t e = (lo << 32) | hi;
-    uint64_t& slot = recent[size_t((e * 0x9E3779B97F4A7C15ull) >> (64 - kCacheBits))];
-    if (slot == e) return;
-    slot = e;
-    edges.push_back(e);
+    uint64_t& slot = cache[size_t((e * 0x9E3779B97F4A7C15ull) >> (64 - kCacheBits))];
+    const uint64_t old = slot;
+    const bool fresh = (old != e) & (a != b);
+    *out = e;
+    out += fresh;
+    slot = fresh ? e : old;
+    if (out == out_end) {
+      const size_t n = edges.size();
+      edges.resize(2 * n);
+      out = edges.data() + n;
+      out_end = edges.data() + edges.size();
+    }
   };
+  const Run* const rn = runs.data();
   for (int y = 0; y < H; ++y) {
     const size_t i0 = row_start[size_t(y)], i1 = row_start[size_t(y) + 1];
     for (size_t i = i0; i < i1; ++i)
-      for (size_t k = i + 1; k < i1 && runs[k].x0 - runs[i].x1 <= R; ++k)
-        if (runs[k].label != runs[i].label) push(runs[i].label, runs[k].label);
+      for (size_t k = i + 1; k < i1 && rn[k].x0 - rn[i].x1 <= R; ++k) push(rn[i].label, rn[k].label);
     for (int dy = 1; dy <= R && y + dy < H; ++dy) {
       size_t j = row_start[size_t(y + dy)];
       const size_t j1 = row_start[size_t(y + dy) + 1];
       for (size_t i = i0; i < i1; ++i) {
-        const Run& u = runs[i];
-        while (j < j1 && runs[j].x1 < u.x0 - R) ++j;  // u.x0 grows with i: j only moves forward
-        for (size_t k = j; k < j1 && runs[k].x0 <= u.x1 + R; ++k)
-          if (runs[k].label != u.label) push(u.label, runs[k].label);
+        const Run u = rn[i];
+        while (j < j1 && rn[j].x1 < u.x0 - R) ++j;  // u.x0 grows with i: j only moves forward
+        for (size_t k = j; k < j1 && rn[k].x0 <= u.x1 + R; ++k) push(u.label, rn[k].label);
       }
     }
   }
+  const size_t num_edges = size_t(out - edges.data());
+  edges.resize(num_edges);
   std::vector<uint64_t>& edge_tmp = ws.edge_tmp;
   std::vector<int>&edge_start = ws.edge_start, &edge_stamp = ws.edge_stamp;
   unique_edges(edges, count, edge_tmp, edge_start, edge_stamp);
@@ -779,34 +924,25 @@ SegmentationResult segment_god(const cv::Mat& image, const cv::Mat& points, cons
   // Merged labels, numbered 1..K in raster order of their first pixel. A root is the smallest initial
   // label of its set, i.e. the set's first initial segment in raster order, so this numbering keeps the
   // order of the roots (the growth's tie-break) and describe_regions gets K instead of `count` slots.
-  // Without debug output the initial labels are relabelled in place (reads precede writes per pixel).
+  // A segment's first pixel is its first run, so the ids are assigned run by run and painted from the
+  // runs. Without debug output the label image is the workspace's buffer.
   cv::Mat labels = debug ? cv::Mat(image.size(), CV_32S) : init_labels;
   std::vector<int>&id_of_initial = ws.id_of_initial, &id_of_root = ws.id_of_root, &root_of_id = ws.root_of_id;
   id_of_initial.assign(size_t(count) + 1, 0);
   id_of_root.assign(size_t(count) + 1, 0);
   root_of_id.assign(1, 0);
-  for (int y = 0; y < H; ++y) {
-    const int* l = init.ptr<int>(y);
-    int* o = labels.ptr<int>(y);
-    for (int x = 0; x < W; ++x) {
-      const int a = l[x];
-      if (a <= 0) {
-        o[x] = 0;
-        continue;
-      }
-      int& id = id_of_initial[size_t(a)];
-      if (id == 0) {
-        const int root = uf.find(a);
-        int& rid = id_of_root[size_t(root)];
-        if (rid == 0) {
-          rid = int(root_of_id.size());
-          root_of_id.push_back(root);
-        }
-        id = rid;
-      }
-      o[x] = id;
+  for (const Run& r : runs) {
+    int& id = id_of_initial[size_t(r.label)];
+    if (id != 0) continue;
+    const int root = uf.find(r.label);
+    int& rid = id_of_root[size_t(root)];
+    if (rid == 0) {
+      rid = int(root_of_id.size());
+      root_of_id.push_back(root);
     }
+    id = rid;
   }
+  paint_runs(ri, image.size(), id_of_initial.data(), labels);
 
   // Boundary growth: unlabeled pixels with a valid point join the 8-neighbour region whose plane is
   // nearest, if within boundary_growth_distance (ties: the smaller label). Each step reads the labels

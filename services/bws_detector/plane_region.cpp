@@ -7,6 +7,10 @@
 
 #include <Eigen/Eigenvalues>
 
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
 namespace bookgrasp::bws {
 
 Plane fit_plane(const PointMoments& m) {
@@ -50,6 +54,22 @@ cv::Mat image_space_points(const cv::Mat& image) {
 
 namespace {
 
+/// One past the last column of the run of `l[x]`'s value that starts at x (the row has W labels).
+inline int run_end(const int* l, int x, int W) {
+  const int v = l[x];
+  int x1 = x + 1;
+#if defined(__SSE2__)
+  const __m128i vv = _mm_set1_epi32(v);
+  for (; x1 + 4 <= W; x1 += 4) {
+    const unsigned m =
+        unsigned(_mm_movemask_epi8(_mm_cmpeq_epi32(_mm_loadu_si128(reinterpret_cast<const __m128i*>(l + x1)), vv)));
+    if (m != 0xffffu) return x1 + __builtin_ctz(~m) / 4;
+  }
+#endif
+  while (x1 < W && l[x1] == v) ++x1;
+  return x1;
+}
+
 /// Moment sums as PointMoments::add makes them (same products, same order), the six distinct products.
 struct Acc {
   int pixels = 0;
@@ -74,35 +94,60 @@ SegmentationResult describe(const cv::Mat& labels, const cv::Mat& points, int mi
   thread_local std::vector<Acc> acc;
   thread_local std::vector<int> order, remap;
   acc.assign(size_t(max_label) + 1, Acc());
+  // Run by run (maximal horizontal pieces of one label): the pixel count and the bounding box once per
+  // run, the sums and the extent pixel by pixel into local copies (the same additions in the same order).
   for (int y = 0; y < labels.rows; ++y) {
     const int* l = labels.ptr<int>(y);
     const cv::Vec3f* p = points.ptr<cv::Vec3f>(y);
-    for (int x = 0; x < labels.cols; ++x) {
+    for (int x = 0; x < labels.cols;) {
       const int lab = l[x];
-      if (lab <= 0) continue;
-      Acc& a = acc[size_t(lab)];
-      if (a.first < 0) a.first = y * labels.cols + x;
-      ++a.pixels;
-      a.x0 = std::min(a.x0, x);
-      a.x1 = std::max(a.x1, x);
-      a.y0 = std::min(a.y0, y);
-      a.y1 = std::max(a.y1, y);
-      const cv::Vec3f& q = p[x];
-      if (std::isfinite(q[0]) && std::isfinite(q[1]) && std::isfinite(q[2])) {
-        const Eigen::Vector3d v(q[0], q[1], q[2]);
-        a.n += 1.0;
-        a.sx += v[0];
-        a.sy += v[1];
-        a.sz += v[2];
-        a.xx += v[0] * v[0];
-        a.xy += v[0] * v[1];
-        a.xz += v[0] * v[2];
-        a.yy += v[1] * v[1];
-        a.yz += v[1] * v[2];
-        a.zz += v[2] * v[2];
-        a.lo = a.lo.cwiseMin(v);
-        a.hi = a.hi.cwiseMax(v);
+      const int x1 = run_end(l, x, labels.cols);
+      if (lab > 0) {
+        Acc& a = acc[size_t(lab)];
+        if (a.first < 0) a.first = y * labels.cols + x;
+        a.pixels += x1 - x;
+        a.x0 = std::min(a.x0, x);
+        a.x1 = std::max(a.x1, x1 - 1);
+        a.y0 = std::min(a.y0, y);
+        a.y1 = std::max(a.y1, y);
+        double n = a.n, sx = a.sx, sy = a.sy, sz = a.sz, xx = a.xx, xy = a.xy, xz = a.xz, yy = a.yy, yz = a.yz,
+               zz = a.zz;
+        double lo0 = a.lo[0], lo1 = a.lo[1], lo2 = a.lo[2], hi0 = a.hi[0], hi1 = a.hi[1], hi2 = a.hi[2];
+        for (int i = x; i < x1; ++i) {
+          const cv::Vec3f& q = p[i];
+          if (!(std::isfinite(q[0]) && std::isfinite(q[1]) && std::isfinite(q[2]))) continue;
+          const double v0 = q[0], v1 = q[1], v2 = q[2];
+          n += 1.0;
+          sx += v0;
+          sy += v1;
+          sz += v2;
+          xx += v0 * v0;
+          xy += v0 * v1;
+          xz += v0 * v2;
+          yy += v1 * v1;
+          yz += v1 * v2;
+          zz += v2 * v2;
+          lo0 = std::min(lo0, v0);  // as cwiseMin / cwiseMax of finite values
+          lo1 = std::min(lo1, v1);
+          lo2 = std::min(lo2, v2);
+          hi0 = std::max(hi0, v0);
+          hi1 = std::max(hi1, v1);
+          hi2 = std::max(hi2, v2);
+        }
+        a.n = n;
+        a.sx = sx;
+        a.sy = sy;
+        a.sz = sz;
+        a.xx = xx;
+        a.xy = xy;
+        a.xz = xz;
+        a.yy = yy;
+        a.yz = yz;
+        a.zz = zz;
+        a.lo = Eigen::Vector3d(lo0, lo1, lo2);
+        a.hi = Eigen::Vector3d(hi0, hi1, hi2);
       }
+      x = x1;
     }
   }
   order.clear();
@@ -139,7 +184,12 @@ SegmentationResult describe(const cv::Mat& labels, const cv::Mat& points, int mi
   for (int y = 0; y < labels.rows; ++y) {
     const int* l = labels.ptr<int>(y);
     int* o = out.labels.ptr<int>(y);
-    for (int x = 0; x < labels.cols; ++x) o[x] = l[x] > 0 ? remap[size_t(l[x])] : 0;
+    for (int x = 0; x < labels.cols;) {  // run by run (in place: a run is read before it is written)
+      const int lab = l[x];
+      const int x1 = run_end(l, x, labels.cols);
+      std::fill(o + x, o + x1, lab > 0 ? remap[size_t(lab)] : 0);
+      x = x1;
+    }
   }
   return out;
 }
