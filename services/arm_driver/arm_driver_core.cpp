@@ -151,6 +151,22 @@ void ArmDriverCore::stop(const std::string& reason) {
   message_ = reason;
 }
 
+Eigen::VectorXd ArmDriverCore::nullspace_objective() const {
+  const int n = static_cast<int>(q_cmd_.size());
+  Eigen::VectorXd g = Eigen::VectorXd::Zero(n);
+  if (params_.nullspace_gain > 0 && params_.preferred_posture.size() == n)
+    g += params_.nullspace_gain * (params_.preferred_posture - q_cmd_);
+  const double m = params_.nullspace_limit_margin;
+  if (m > 0 && params_.nullspace_limit_gain > 0 && limits_.lower.size() == n && limits_.upper.size() == n) {
+    for (int j = 0; j < n; ++j) {
+      const double to_lower = q_cmd_[j] - limits_.lower[j], to_upper = limits_.upper[j] - q_cmd_[j];
+      if (to_lower < m) g[j] += params_.nullspace_limit_gain * (m - std::max(to_lower, 0.0)) / m;
+      if (to_upper < m) g[j] -= params_.nullspace_limit_gain * (m - std::max(to_upper, 0.0)) / m;
+    }
+  }
+  return g;
+}
+
 DriverSetpoint ArmDriverCore::update(int64_t now_utime) {
   if (now_utime > now_) now_ = now_utime;
   const double dt = last_update_ < 0 ? 0.0 : (now_ - last_update_) * 1e-6;
@@ -182,11 +198,12 @@ DriverSetpoint ArmDriverCore::update(int64_t now_utime) {
     const double l2 = params_.cartesian_damping * params_.cartesian_damping;
     const Eigen::Matrix<double, 6, 6> jjt = jac * jac.transpose() + l2 * Eigen::Matrix<double, 6, 6>::Identity();
     Eigen::VectorXd qd = jac.transpose() * jjt.ldlt().solve(tw);
-    if (params_.nullspace_gain > 0 && params_.preferred_posture.size() == qd.size()) {
+    const Eigen::VectorXd secondary = nullspace_objective();
+    if (secondary.size() == qd.size() && secondary.squaredNorm() > 0) {
       // Null-space projector of the damped pseudo-inverse J+ = J^T (J J^T + lambda^2 I)^-1: N = I - J+ J.
       const Eigen::MatrixXd jpinv = jac.transpose() * jjt.ldlt().solve(Eigen::Matrix<double, 6, 6>::Identity());
       const Eigen::MatrixXd n = Eigen::MatrixXd::Identity(qd.size(), qd.size()) - jpinv * jac;
-      Eigen::VectorXd qn = n * (params_.nullspace_gain * (params_.preferred_posture - q_cmd_));
+      Eigen::VectorXd qn = n * secondary;
       if (qn.norm() > params_.nullspace_max_speed) qn *= params_.nullspace_max_speed / qn.norm();
       qd += qn;
     }

@@ -28,8 +28,14 @@ struct DriverParams {
   /// joint motion that leaves the TCP twist unchanged is used to keep the arm near that posture (the swivel
   /// the planner chose, away from the wrist's limits) instead of drifting while a servo runs.
   double nullspace_gain = 0.0;
-  double nullspace_max_speed = 0.3;    ///< rad/s, largest null-space joint speed (norm)
-  Eigen::VectorXd preferred_posture;   ///< rad, one value per arm joint (empty = no null-space term)
+  double nullspace_max_speed = 0.3;   ///< rad/s, largest null-space joint speed (norm)
+  Eigen::VectorXd preferred_posture;  ///< rad, one value per arm joint (empty = no null-space term)
+  /// Null-space push away from the joint limits during Cartesian velocity: a joint nearer than this to a
+  /// limit (rad; 0 = none) is pushed away with a speed rising linearly to `nullspace_limit_gain` at the
+  /// limit, within the redundancy (the TCP twist is unchanged), so a straight move or a servo does not stop
+  /// at a wrist limit the redundant joint could have avoided. Added to the posture pull before projection.
+  double nullspace_limit_margin = 0.0;
+  double nullspace_limit_gain = 0.0;   ///< rad/s at the limit (the push at the margin's edge is 0)
   double gripper_max_width = 0.0602;   ///< m
   double gripper_min_width = 0.0;      ///< m
   double gripper_default_force = 100;  ///< N, used when a command gives 0
@@ -93,6 +99,9 @@ class ArmDriverCore {
   const ArmLimits& limits() const { return limits_; }
 
  private:
+  /// The joint velocity the null space should realise as far as it can (rad/s): the posture pull plus the
+  /// push away from the joint limits (DriverParams); zero when neither is configured.
+  Eigen::VectorXd nullspace_objective() const;
   /// A measured plate distance as a gripper target: clamped to [gripper_min_width, gripper_max_width].
   double hold_width(double measured) const;
   /// The gripper's setpoint from a measurement: hold the width, or keep squeezing what the plates touch.

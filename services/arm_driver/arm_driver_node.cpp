@@ -67,6 +67,8 @@ ArmDriverCore make_arm_driver_core(const Config& root) {
   p.cartesian_damping = root.get_double("cartesian_damping", 0.0, 1.0);
   p.nullspace_gain = root.get_double("cartesian_nullspace.gain", 0.0, 10.0);
   p.nullspace_max_speed = root.get_double("cartesian_nullspace.max_speed", 0.0, 2.0);
+  p.nullspace_limit_margin = root.get_double("cartesian_nullspace.limit_margin_rad", 0.0, 1.0);
+  p.nullspace_limit_gain = root.get_double("cartesian_nullspace.limit_gain", 0.0, 10.0);
   const std::vector<double> pp = root.get_vector("cartesian_nullspace.preferred_posture", 7);
   p.preferred_posture = Eigen::Map<const Eigen::VectorXd>(pp.data(), 7);
   for (int j = 0; j < 7; ++j)

@@ -7,7 +7,8 @@
 namespace bookgrasp {
 namespace {
 
-ArmDriverCore make_core(double nullspace_gain = 0.0, const Eigen::VectorXd& preferred = Eigen::VectorXd()) {
+ArmDriverCore make_core(double nullspace_gain = 0.0, const Eigen::VectorXd& preferred = Eigen::VectorXd(),
+                        double limit_margin = 0.0, double limit_gain = 0.0) {
   ArmKinematics kin = ArmKinematics::from_urdf_file(std::string(BOOKGRASP_SOURCE_DIR) + "/config/robot/lwa3_pg70.urdf",
                                                     "base", "gripper");
   ArmLimits l;
@@ -25,6 +26,8 @@ ArmDriverCore make_core(double nullspace_gain = 0.0, const Eigen::VectorXd& pref
   p.heartbeat_timeout_s = 0.5;
   p.nullspace_gain = nullspace_gain;
   p.preferred_posture = preferred;
+  p.nullspace_limit_margin = limit_margin;
+  p.nullspace_limit_gain = limit_gain;
   return ArmDriverCore(std::move(kin), l, p);
 }
 
@@ -259,6 +262,67 @@ TEST(ArmDriverCore, NullspacePullKeepsTheTcpAndApproachesThePreferredPosture) {
   EXPECT_NEAR(dp.x(), 0.02, 0.002);
   EXPECT_NEAR(dp.y(), 0.0, 0.002);
   EXPECT_NEAR(dp.z(), 0.0, 0.002);
+}
+
+// Runs a straight move of `twist` (base frame) for at most 4 s at 100 Hz; returns how far the TCP went
+// before the driver stopped (or in 4 s) and the smallest distance of any joint to its limit on the way.
+std::pair<double, double> straight_move_distance(ArmDriverCore& d, const Eigen::VectorXd& start,
+                                                 const Eigen::Matrix<double, 6, 1>& twist) {
+  d.on_measurement(kT0, start, 0.06);
+  const Eigen::Vector3d p0 = d.kinematics().tip_pose(start).translation();
+  EXPECT_EQ(d.command_cartesian_velocity(twist, "base", 1), "");
+  d.update(kT0);
+  DriverSetpoint sp;
+  double closest = 1e9;
+  for (int64_t t = kT0 + 10000; t <= kT0 + 4000000; t += 10000) {
+    d.heartbeat();
+    sp = d.update(t);
+    if (d.state() != DriverState::kExecuting) break;
+    for (int j = 0; j < 7; ++j)
+      closest = std::min({closest, sp.q[j] - d.limits().lower[j], d.limits().upper[j] - sp.q[j]});
+  }
+  return {(d.kinematics().tip_pose(sp.q).translation() - p0).norm(), closest};
+}
+
+// far_cart seed 16 (stop 16): the retreat from the holder, 5 cm/s along base -y from this logged posture,
+// drove arm_6 from -1.83 into its -1.97 limit after 9 cm of the 10 cm asked. The push away from the limits
+// uses the redundant joint so the same move goes on well past 10 cm, the TCP still moving straight.
+TEST(ArmDriverCore, NullspaceLimitPushKeepsAStraightMoveAwayFromAWristLimit) {
+  Eigen::VectorXd start(7);
+  start << 0.1500428311, 1.453928765, 0.1982606048, 0.8325352503, 1.533321834, -1.834285604, 2.035539293;
+  Eigen::VectorXd preferred(7);
+  preferred << 0.0, 0.6, 0.0, 1.5, 0.0, 0.6, 0.0;
+  Eigen::Matrix<double, 6, 1> tw = Eigen::Matrix<double, 6, 1>::Zero();
+  tw[1] = -0.05;
+
+  ArmDriverCore pull_only = make_core(0.5, preferred);
+  const auto [without, closest_without] = straight_move_distance(pull_only, start, tw);
+  EXPECT_EQ(pull_only.state(), DriverState::kStopped) << "the case this test is about: it stops without the push";
+  EXPECT_NE(pull_only.message().find("arm_6_joint"), std::string::npos) << pull_only.message();
+  EXPECT_LT(without, 0.10);
+
+  ArmDriverCore pushed = make_core(0.5, preferred, 0.4, 2.0);
+  const Eigen::Isometry3d tip0 = pushed.kinematics().tip_pose(start);
+  const auto [with, closest_with] = straight_move_distance(pushed, start, tw);
+  EXPECT_GT(with, 0.14) << pushed.message();
+  EXPECT_GE(closest_with, 0.0);
+  // Straight: the TCP moved along -y only, orientation unchanged (checked at 10 cm along the way).
+  ArmDriverCore again = make_core(0.5, preferred, 0.4, 2.0);
+  again.on_measurement(kT0, start, 0.06);
+  ASSERT_EQ(again.command_cartesian_velocity(tw, "base", 2), "");
+  again.update(kT0);
+  DriverSetpoint sp;
+  for (int64_t t = kT0 + 10000; t <= kT0 + 2000000; t += 10000) {
+    again.heartbeat();
+    sp = again.update(t);
+  }
+  ASSERT_EQ(again.state(), DriverState::kExecuting) << again.message();
+  const Eigen::Isometry3d tip1 = again.kinematics().tip_pose(sp.q);
+  const Eigen::Vector3d dp = tip1.translation() - tip0.translation();
+  EXPECT_NEAR(dp.y(), -0.10, 0.003);
+  EXPECT_NEAR(dp.x(), 0.0, 0.003);
+  EXPECT_NEAR(dp.z(), 0.0, 0.003);
+  EXPECT_LT(Eigen::AngleAxisd(tip0.linear().transpose() * tip1.linear()).angle(), 0.01);
 }
 
 TEST(ArmDriverCore, BadCartesianAndGripperCommandsAreRefused) {

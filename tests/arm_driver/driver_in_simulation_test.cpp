@@ -6,6 +6,7 @@
 #include <cmath>
 #include <fstream>
 #include <sstream>
+#include <vector>
 
 #include "bookgrasp/arm_command_t.hpp"
 #include "bookgrasp/arm_state_t.hpp"
@@ -194,25 +195,38 @@ TEST(DriverConfig, NullspacePostureOutsideTheLimitsIsRefused) {
   }
 }
 
-// A negative or missing gripper.open_margin_m is a configuration error naming the key.
-TEST(DriverConfig, GripperOpenMarginOutOfRangeOrMissingIsRefused) {
+// arm_driver.yaml with `good` (which must occur in it) replaced by each of `bads` is refused with an error
+// naming `key`.
+void expect_config_refused(const std::string& good, const std::vector<std::string>& bads, const std::string& key) {
   std::ifstream in(kSrc + "/config/services/arm_driver.yaml");
   std::stringstream ss;
   ss << in.rdbuf();
   const std::string text = ss.str();
-  const std::string good = "open_margin_m: 0.003";
   const auto at = text.find(good);
   ASSERT_NE(at, std::string::npos) << "arm_driver.yaml changed: update this test";
-  for (const std::string& bad : {std::string("open_margin_m: -0.001"), std::string("")}) {
+  for (const std::string& bad : bads) {
     std::string changed = text;
     changed.replace(at, good.size(), bad);
     try {
       make_arm_driver_core(Config::from_string(changed, "arm_driver.yaml"));
       FAIL() << "no error for '" << bad << "'";
     } catch (const ConfigError& e) {
-      EXPECT_NE(std::string(e.what()).find("open_margin_m"), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find(key), std::string::npos) << e.what();
     }
   }
+}
+
+// A negative or missing gripper.open_margin_m is a configuration error naming the key.
+TEST(DriverConfig, GripperOpenMarginOutOfRangeOrMissingIsRefused) {
+  expect_config_refused("open_margin_m: 0.003", {"open_margin_m: -0.001", ""}, "open_margin_m");
+}
+
+// The null-space limit push: a negative, too large or missing margin or gain is refused, naming the key.
+TEST(DriverConfig, NullspaceLimitPushOutOfRangeOrMissingIsRefused) {
+  expect_config_refused("limit_margin_rad: 0.4", {"limit_margin_rad: -0.1", "limit_margin_rad: 2.0", ""},
+                        "cartesian_nullspace.limit_margin_rad");
+  expect_config_refused("limit_gain: 2.0", {"limit_gain: -1", "limit_gain: .nan", ""},
+                        "cartesian_nullspace.limit_gain");
 }
 
 }  // namespace
