@@ -529,6 +529,7 @@ struct FullCycleHarness::Impl {
     cv::Mat bgr;
     if (have_hand) {
       cv::cvtColor(image_to_mat(last_hand.image), bgr, cv::COLOR_RGB2BGR);
+      cv::imwrite(base + "_hand_raw.png", bgr);  // what the detectors saw, to re-run them offline
       if (last_stripe_f.utime == last_hand.utime && last_stripe_f.found) {
         const double* l = last_stripe_f.centre_line_px;
         cv::line(bgr, cv::Point2d(l[0], l[1]), cv::Point2d(l[2], l[3]), cv::Scalar(255, 255, 0), 1);
