@@ -27,6 +27,13 @@ SelectionParams SelectionParams::from_config(const Config& c) {
   p.split_wide_fronts = c.get<bool>("split_wide_fronts");
   p.split_top_jump_px = c.get_int("split_top_jump_px", 1, 1000);
   p.split_depth_step_m = c.get_double("split_depth_step_m", 0.0, 1.0);
+  p.top_growth_px = c.get_int("top_growth_px", 0, 1000);
+  p.top_growth_disparity_px = c.get_double("top_growth_disparity_px", 0.0, 100.0);
+  p.top_growth_max_gap_px = c.get_int("top_growth_max_gap_px", 0, 1000);
+  p.top_growth_columns = c.get_int("top_growth_columns", 1, 1000);
+  p.edge_fattening_px = c.get_double("edge_fattening_px", 0.0, 100.0);
+  p.pi_rule =
+      c.get_choice("pi_rule", {"paper", "right_column_top"}) == "paper" ? PiRule::kPaper : PiRule::kRightColumnTop;
   return p;
 }
 
@@ -64,6 +71,66 @@ cv::Point upper_right_corner(const cv::Mat& labels, int label, bool* fallback) {
     }
   }
   return best_p;
+}
+
+cv::Point right_column_top(const cv::Mat& labels, int label) {
+  constexpr int kMinColumnPixels = 3;
+  if (labels.type() != CV_32S) throw std::invalid_argument("right_column_top: labels must be CV_32S");
+  std::vector<int> count(size_t(labels.cols), 0);
+  for (int y = 0; y < labels.rows; ++y) {
+    const int* l = labels.ptr<int>(y);
+    for (int x = 0; x < labels.cols; ++x) count[size_t(x)] += l[x] == label;
+  }
+  const int fullest = *std::max_element(count.begin(), count.end());
+  if (fullest == 0) throw std::invalid_argument("right_column_top: label " + std::to_string(label) + " not present");
+  const int need = std::min(kMinColumnPixels, fullest);
+  int x = labels.cols - 1;
+  while (count[size_t(x)] < need) --x;
+  int top = -1;
+  for (int y = 0; y < labels.rows; ++y) {
+    if (labels.at<int>(y, x) != label) continue;
+    if (top < 0) top = y;
+    if (y + 1 < labels.rows && labels.at<int>(y + 1, x) == label) return {x, y};
+  }
+  return {x, top};
+}
+
+cv::Point raise_to_plane_top(const cv::Mat& labels, int label, cv::Point pi, const cv::Mat& points_camera,
+                             const Eigen::Vector3d& normal, double offset, const StereoGeometry& g, double tolerance_px,
+                             int max_px, int max_gap_px, int columns) {
+  if (labels.type() != CV_32S || points_camera.type() != CV_32FC3 || points_camera.size() != labels.size())
+    throw std::invalid_argument("raise_to_plane_top: CV_32S labels and CV_32FC3 points of one size expected");
+  const double fb = g.fx * g.baseline_m;
+  std::vector<int> tops;
+  for (int x = pi.x; x > pi.x - columns && x >= 0; --x) {
+    int top = -1;
+    for (int y = 0; y < labels.rows && top < 0; ++y)
+      if (labels.at<int>(y, x) == label) top = y;
+    if (top < 0) continue;
+    int gap = 0;
+    const int start = top;
+    for (int y = start - 1; y >= 0 && start - y <= max_px; --y) {
+      const cv::Vec3f q = points_camera.at<cv::Vec3f>(y, x);
+      const Eigen::Vector3d ray((x - g.cx) / g.fx, (y - g.cy) / g.fy, 1.0);
+      const double denom = normal.dot(ray);
+      if (!std::isfinite(q[2]) || q[2] <= 0.0f) {
+        if (++gap > max_gap_px) break;
+        continue;
+      }
+      if (std::fabs(denom) < 1e-9) break;
+      const double z_plane = offset / denom;
+      if (!(z_plane > 0.0) || std::fabs(fb / q[2] - fb / z_plane) > tolerance_px) {
+        if (++gap > max_gap_px) break;
+        continue;
+      }
+      top = y;
+      gap = 0;
+    }
+    tops.push_back(top);
+  }
+  if (tops.empty()) return pi;
+  std::nth_element(tops.begin(), tops.begin() + long(tops.size() / 2), tops.end());
+  return {pi.x, std::min(pi.y, tops[tops.size() / 2])};
 }
 
 namespace {
@@ -201,6 +268,52 @@ BookFrontResult select_book_front(const SegmentationResult& seg, const cv::Mat& 
       if (l[x] > 0 && size_t(l[x]) <= K && point_ok(q[x])) ++first[size_t(l[x]) + 1];
   }
   for (size_t i = 1; i < first.size(); ++i) first[i] += first[i - 1];
+  const Eigen::Matrix3d R = camera_in_base.linear();
+  const Eigen::Vector3d rear_n = shelf.box_in_base.linear().col(0);
+  const Eigen::Vector3d shelf_n = shelf.box_in_base.linear().col(2);
+  const double cos_par = std::cos(p.parallel_tolerance_deg * M_PI / 180.0);
+  const double sin_perp = std::sin(p.perpendicular_tolerance_deg * M_PI / 180.0);
+  const auto in_volume = [&](const Eigen::Vector3f& q) {
+    return std::fabs(q.x()) <= shelf.half_extent.x() && std::fabs(q.y()) <= shelf.half_extent.y() &&
+           std::fabs(q.z()) <= shelf.half_extent.z();
+  };
+  // Regions oriented like a book front are measured where each pixel's viewing ray meets the region's
+  // fitted plane, not at the pixel's own noisy stereo point: a book front is 4-15 px wide, and the depth
+  // noise of single pixels (several mm, along oblique rays partly across the shelf) made its extents and
+  // its column bands' widths up to twice the book's.
+  std::vector<char> on_plane(K + 1, 0);
+  for (const PlaneRegion& r : seg.regions) {
+    const Eigen::Vector3d n = R * r.normal;
+    on_plane[size_t(r.label)] = std::fabs(n.dot(rear_n)) >= cos_par && std::fabs(n.dot(shelf_n)) <= sin_perp;
+  }
+  const auto measured_point = [&](const PlaneRegion& r, int x, int y, const cv::Vec3f& q) -> Eigen::Vector3d {
+    const Eigen::Vector3d raw(q[0], q[1], q[2]);
+    if (!on_plane[size_t(r.label)]) return raw;
+    const Eigen::Vector3d ray((x - g.cx) / g.fx, (y - g.cy) / g.fy, 1.0);
+    const double denom = r.normal.dot(ray);
+    if (std::fabs(denom) <= 0.05 * ray.norm()) return raw;
+    return ray * (r.offset / denom);
+  };
+  // The pixels of region r whose measured point lies inside the upper-shelf volume, as r.label in
+  // `mask` (CV_32S, 0 elsewhere, or only in r's bounding box when bbox_only): the shelf board's front
+  // edge and the rear board, coplanar with the fronts, can merge into a front region but lie outside
+  // the volume.
+  const auto inside_pixels = [&](const PlaneRegion& r, cv::Mat& mask, bool bbox_only) {
+    mask.create(seg.labels.size(), CV_32S);
+    (bbox_only ? mask(r.bbox) : mask).setTo(cv::Scalar(0));
+    for (int y = r.bbox.y; y < r.bbox.y + r.bbox.height; ++y) {
+      const int* l = seg.labels.ptr<int>(y);
+      const cv::Vec3f* q = points_camera.ptr<cv::Vec3f>(y);
+      int* o = mask.ptr<int>(y);
+      for (int x = r.bbox.x; x < r.bbox.x + r.bbox.width; ++x) {
+        if (l[x] != r.label || !point_ok(q[x])) continue;
+        const Eigen::Vector3d qb = cam_in_box * measured_point(r, x, y, q[x]);
+        if (std::fabs(qb.x()) <= shelf.half_extent.x() && std::fabs(qb.y()) <= shelf.half_extent.y() &&
+            std::fabs(qb.z()) <= shelf.half_extent.z())
+          o[x] = r.label;
+      }
+    }
+  };
   // The large scratch buffers are per thread and keep their capacity across frames (no fresh pages per
   // frame); each is sized and filled per call as before.
   thread_local std::vector<Eigen::Vector3f> box_pts;
@@ -213,15 +326,11 @@ BookFrontResult select_book_front(const SegmentationResult& seg, const cv::Mat& 
       for (int x = 0; x < seg.labels.cols; ++x) {
         const int lab = l[x];
         if (lab <= 0 || size_t(lab) > K || !point_ok(q[x])) continue;
-        box_pts[fill[size_t(lab)]++] = (cam_in_box * Eigen::Vector3d(q[x][0], q[x][1], q[x][2])).cast<float>();
+        box_pts[fill[size_t(lab)]++] =
+            (cam_in_box * measured_point(seg.regions[size_t(lab - 1)], x, y, q[x])).cast<float>();
       }
     }
   }
-  const Eigen::Matrix3d R = camera_in_base.linear();
-  const Eigen::Vector3d rear_n = shelf.box_in_base.linear().col(0);
-  const Eigen::Vector3d shelf_n = shelf.box_in_base.linear().col(2);
-  const double cos_par = std::cos(p.parallel_tolerance_deg * M_PI / 180.0);
-  const double sin_perp = std::sin(p.perpendicular_tolerance_deg * M_PI / 180.0);
 
   BookFrontResult out;
   int best = 0;
@@ -253,21 +362,23 @@ BookFrontResult select_book_front(const SegmentationResult& seg, const cv::Mat& 
     const Eigen::Vector3f* pts = box_pts.data() + first[size_t(r.label)];
     const size_t num_pts = first[size_t(r.label) + 1] - first[size_t(r.label)];
     if (num_pts > 0) {
-      for (int i = 0; i < 3; ++i) c[i].resize(num_pts);
-      b1.resize(num_pts);
-      b2.resize(num_pts);
-      int inside = 0;
+      size_t inside = 0;
+      for (size_t j = 0; j < num_pts; ++j) inside += in_volume(pts[j]);
+      v.inside_fraction = double(inside) / double(num_pts);
+      // A front-like region is measured by its part inside the volume (a shelf board's edge merged with
+      // the fronts is not part of a book); other regions by all their points.
+      const bool inside_only = on_plane[size_t(r.label)] && inside > 0;
+      for (int i = 0; i < 3; ++i) c[i].clear();
+      b1.clear();
+      b2.clear();
       for (size_t j = 0; j < num_pts; ++j) {
         const Eigen::Vector3f& q = pts[j];
+        if (inside_only && !in_volume(q)) continue;
         const Eigen::Vector3d qb = shelf.box_in_base * q.cast<double>();
-        for (int i = 0; i < 3; ++i) c[i][j] = qb(i);
-        b1[j] = q(1);
-        b2[j] = q(2);
-        if (std::fabs(q.x()) <= shelf.half_extent.x() && std::fabs(q.y()) <= shelf.half_extent.y() &&
-            std::fabs(q.z()) <= shelf.half_extent.z())
-          ++inside;
+        for (int i = 0; i < 3; ++i) c[i].push_back(qb(i));
+        b1.push_back(q(1));
+        b2.push_back(q(2));
       }
-      v.inside_fraction = double(inside) / double(num_pts);
       for (int i = 0; i < 3; ++i)
         std::tie(v.extent_min_base(i), v.extent_max_base(i)) = quantile_pair(c[i], p.extent_quantile);
       const auto [w0, w1] = quantile_pair(b1, p.extent_quantile);
@@ -292,29 +403,42 @@ BookFrontResult select_book_front(const SegmentationResult& seg, const cv::Mat& 
       // Several coplanar fronts side by side: split into column bands, keep the right-most band that
       // looks like one book front.
       make_rear_depth();
-      const std::vector<std::pair<int, int>> bands = column_bands(seg.labels, r.label, r.bbox, rear_depth, p);
+      thread_local cv::Mat inside;
+      inside_pixels(r, inside, true);  // only its bounding box is read
+      const std::vector<std::pair<int, int>> bands = column_bands(inside, r.label, r.bbox, rear_depth, p);
       double band_best_y = std::numeric_limits<double>::infinity();
       int passed = 0;
       for (const auto& [x0, x1] : bands) {
         std::vector<double> by, bz;
         double sum_y = 0.0;
         for (int y = r.bbox.y; y < r.bbox.y + r.bbox.height; ++y) {
-          const int* l = seg.labels.ptr<int>(y);
+          const int* l = inside.ptr<int>(y);
           const cv::Vec3f* q = points_camera.ptr<cv::Vec3f>(y);
           for (int x = x0; x <= x1; ++x) {
-            if (l[x] != r.label || !std::isfinite(q[x][2])) continue;
-            const Eigen::Vector3d qc(q[x][0], q[x][1], q[x][2]);
+            if (l[x] != r.label) continue;
+            const Eigen::Vector3d qc = measured_point(r, x, y, q[x]);
             const Eigen::Vector3d qb = cam_in_box * qc;
             by.push_back(qb.y());
             bz.push_back(qb.z());
             sum_y += (camera_in_base * qc).y();
           }
         }
-        if (int(by.size()) < p.min_pixels) continue;
+        v.bands += (v.bands.empty() ? "[" : "; [") + std::to_string(x0) + ", " + std::to_string(x1) + "]";
+        if (int(by.size()) < p.min_pixels) {
+          v.bands += " " + std::to_string(by.size()) + " px: too small";
+          continue;
+        }
         const auto [y0, y1] = quantile_pair(by, p.extent_quantile);
         const auto [z0, z1] = quantile_pair(bz, p.extent_quantile);
         const double w = y1 - y0, h = z1 - z0;
-        if (w < p.min_width_m || w > p.max_width_m || h < p.min_height_m || h > p.max_height_m) continue;
+        v.bands += " w " + fmt(w) + " h " + fmt(h);
+        if (w < p.min_width_m || h < p.min_height_m || h > p.max_height_m) {
+          v.bands += ": not a book front";
+          continue;
+        }
+        // Wider than one book: fronts of one height at one depth, which neither the top contour nor the
+        // depth separates; the band's upper-right corner is still the right-most one's.
+        v.bands += w > p.max_width_m ? ": ok (several fronts of one height)" : ": ok";
         ++passed;
         const double cy = sum_y / double(by.size());
         if (cy < band_best_y) {
@@ -324,7 +448,7 @@ BookFrontResult select_book_front(const SegmentationResult& seg, const cv::Mat& 
       }
       if (passed == 0) {
         v.reason = "width " + fmt(v.width_m) + " m > " + fmt(p.max_width_m) + " and none of its " +
-                   std::to_string(bands.size()) + " column bands is a book front";
+                   std::to_string(bands.size()) + " column bands is a book front: " + v.bands;
       } else {
         v.candidate = true;
         if (band_best_y < best_y) {
@@ -354,6 +478,12 @@ BookFrontResult select_book_front(const SegmentationResult& seg, const cv::Mat& 
   const PlaneRegion& r = seg.regions[size_t(best - 1)];
   out.selected_label = best;
   double offset = r.offset;
+  cv::Mat band_mask, inside_mask;  // the pixels PI is taken from
+  const auto corner_of = [&](const cv::Mat& labels) {
+    if (p.pi_rule == PiRule::kPaper) return upper_right_corner(labels, best, &out.pi_fallback);
+    out.pi_fallback = false;
+    return right_column_top(labels, best);
+  };
   if (band_of[size_t(best)].first >= 0) {
     // A band of a wider region: PI of the band's pixels; the plane keeps the region's normal and takes
     // the band's own offset (median of n . p), since neighbouring fronts can stand at other depths.
@@ -361,25 +491,39 @@ BookFrontResult select_book_front(const SegmentationResult& seg, const cv::Mat& 
     out.band_x0 = band_of[size_t(best)].first;
     out.band_x1 = band_of[size_t(best)].second;
     thread_local cv::Mat band;
-    band.create(seg.labels.size(), CV_32S);
-    band.setTo(cv::Scalar(0));
+    inside_pixels(r, band, false);
     std::vector<double> offs;
     for (int y = r.bbox.y; y < r.bbox.y + r.bbox.height; ++y) {
-      const int* l = seg.labels.ptr<int>(y);
       const cv::Vec3f* q = points_camera.ptr<cv::Vec3f>(y);
       int* o = band.ptr<int>(y);
-      for (int x = out.band_x0; x <= out.band_x1; ++x) {
-        if (l[x] != best) continue;
-        o[x] = best;
-        if (std::isfinite(q[x][2])) offs.push_back(r.normal.dot(Eigen::Vector3d(q[x][0], q[x][1], q[x][2])));
+      for (int x = r.bbox.x; x < r.bbox.x + r.bbox.width; ++x) {
+        if (o[x] != best) continue;
+        if (x < out.band_x0 || x > out.band_x1) {
+          o[x] = 0;
+          continue;
+        }
+        offs.push_back(r.normal.dot(Eigen::Vector3d(q[x][0], q[x][1], q[x][2])));
       }
     }
     if (!offs.empty()) offset = quantile(offs, 0.5);
-    out.pi = upper_right_corner(band, best, &out.pi_fallback);
+    out.pi = corner_of(band);
+    band_mask = band;
   } else {
-    out.pi = upper_right_corner(seg.labels, best, &out.pi_fallback);
+    // PI of the region's pixels inside the upper-shelf volume (all of them when none is: the region
+    // passed the volume test with its raw points).
+    thread_local cv::Mat inside;
+    inside_pixels(r, inside, false);
+    inside_mask = cv::countNonZero(inside) > 0 ? inside : seg.labels;
+    out.pi = corner_of(inside_mask);
   }
-  const Eigen::Vector3d ray((out.pi.x - g.cx) / g.fx, (out.pi.y - g.cy) / g.fy, 1.0);
+  if (p.top_growth_px > 0)
+    out.pi =
+        raise_to_plane_top(out.split ? band_mask : inside_mask, best, out.pi, points_camera, r.normal, offset, g,
+                           p.top_growth_disparity_px, p.top_growth_px, p.top_growth_max_gap_px, p.top_growth_columns);
+  // P1's ray: through PI moved edge_fattening_px left and down (StereoBM's border of a near surface
+  // in front of a farther one lies that far out; the right-most front's right and top edges are such).
+  const Eigen::Vector3d ray((out.pi.x - p.edge_fattening_px - g.cx) / g.fx,
+                            (out.pi.y + p.edge_fattening_px - g.cy) / g.fy, 1.0);
   const double denom = r.normal.dot(ray);
   if (std::fabs(denom) > 0.05 * ray.norm()) {
     out.p1_camera = ray * (offset / denom);

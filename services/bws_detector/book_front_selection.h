@@ -39,6 +39,15 @@ struct ShelfVolume {
   Eigen::Vector3d half_extent = Eigen::Vector3d::Zero();
 };
 
+/// How PI is found in the selected region (config `selection.pi_rule`).
+enum class PiRule {
+  /// The paper's (Y_min, X_max), or the nearest region pixel to it (upper_right_corner).
+  kPaper,
+  /// The top of the region's right-most well-filled column (right_column_top): the right-most book's
+  /// own top even when a taller front to its left is part of the same region or band.
+  kRightColumnTop,
+};
+
 /// Thresholds of the book-front tests (config section `selection`).
 struct SelectionParams {
   /// Max angle between the region normal and the rear-board normal (box x), degrees.
@@ -68,6 +77,23 @@ struct SelectionParams {
   /// ... or where the median depth along the rear-board normal of neighbouring columns differs by
   /// more than this (metres; fore-edges at different depths), or at a column without region pixels.
   double split_depth_step_m = 0.008;
+  /// How PI is found in the selected region or band.
+  PiRule pi_rule = PiRule::kRightColumnTop;
+  /// PI then moves up its column over at most this many pixels whose stereo depth agrees with the
+  /// front's plane (raise_to_plane_top; 0 = off): the segmentation often leaves the top of a narrow
+  /// front to a region mixed with the book's top face.
+  int top_growth_px = 0;
+  /// Agreement with the plane for that growth, disparity pixels.
+  double top_growth_disparity_px = 0.3;
+  /// Rows without stereo depth or off the plane (StereoBM's holes and outliers) bridged in a row by that
+  /// growth.
+  int top_growth_max_gap_px = 3;
+  /// PI's new row is the median of the grown tops of this many columns ending at PI's.
+  int top_growth_columns = 3;
+  /// P1's viewing ray passes this many pixels left of and below PI: block matching extends a near
+  /// surface into a farther background by up to half a block ((block_size - 1) / 2), and the
+  /// right-most front's right and top edges border a farther background. 0 = the ray through PI.
+  double edge_fattening_px = 0.0;
 
   /// Reads every key of the `selection` section.
   static SelectionParams from_config(const Config& section);
@@ -97,6 +123,9 @@ struct RegionVerdict {
   double height_m = 0.0;
   /// Fraction of the region's points inside the shelf volume.
   double inside_fraction = 0.0;
+  /// For a region split into column bands (see SelectionParams::split_wide_fronts): one entry per
+  /// band, "[x0, x1] w W h H: ok" or the test it failed. Empty otherwise.
+  std::string bands;
 };
 
 /// Result of the selection.
@@ -129,6 +158,24 @@ struct BookFrontResult {
 /// The paper's PI of a region: (Y_min, X_max) or the nearest region pixel (see the file comment).
 /// `fallback` (optional) tells which case applied. Throws std::invalid_argument if the label is absent.
 cv::Point upper_right_corner(const cv::Mat& labels, int label, bool* fallback = nullptr);
+
+/// PI as the top of the right-most well-filled column of `label`: the right-most column holding at
+/// least 3 region pixels (or as many as the fullest column holds, if fewer; one or two stray pixels at
+/// the region's right border do not count), and in it the topmost region pixel whose lower neighbour
+/// is in the region too (the topmost pixel when none is). Throws std::invalid_argument if the label
+/// is absent.
+cv::Point right_column_top(const cv::Mat& labels, int label);
+
+/// Moves `pi` up to the top of the front's plane as the stereo depth sees it. In each of `columns`
+/// columns ending at pi.x (those holding region pixels), from the column's topmost region pixel, rows
+/// above are taken while the pixel's disparity (fx B / z of `points_camera`) is within `tolerance_px`
+/// of the disparity of the plane { p : normal . p = offset } (left camera frame, metres) on that
+/// pixel's ray, up to `max_gap_px` pixels in a row without depth or off the plane bridged (StereoBM
+/// leaves holes and outliers on a narrow front), at most `max_px` rows; the
+/// result keeps pi.x and takes the median of the columns' tops (never lower than pi.y).
+cv::Point raise_to_plane_top(const cv::Mat& labels, int label, cv::Point pi, const cv::Mat& points_camera,
+                             const Eigen::Vector3d& normal, double offset, const StereoGeometry& geometry,
+                             double tolerance_px, int max_px, int max_gap_px, int columns);
 
 /// Runs the book-front tests on every region of `segmentation` (planes in the
 /// left camera frame, metres), picks the right-most candidate (smallest base y

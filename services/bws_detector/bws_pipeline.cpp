@@ -23,7 +23,7 @@ BwsParams BwsParams::from_config(const Config& root) {
 
 SegmentationResult segment(const cv::Mat& disparity, const cv::Mat& points, const BwsParams& p) {
   if (p.implementation == kImplGod) return segment_god(disparity, points, p.god);
-  if (p.implementation == kImplPcl) return segment_pcl_planes(points, p.pcl);
+  if (p.implementation == kImplPcl) return segment_pcl_planes(disparity, points, p.pcl);
   throw std::invalid_argument("unknown segmentation implementation '" + p.implementation + "' (use god or pcl)");
 }
 

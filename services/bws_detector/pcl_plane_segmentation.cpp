@@ -15,6 +15,8 @@ namespace bookgrasp::bws {
 
 PclPlaneParams PclPlaneParams::from_config(const Config& c) {
   PclPlaneParams p;
+  p.space = c.get_choice("space", {"points", "image"}) == "image" ? PclSpace::kImage : PclSpace::kPoints;
+  p.disparity_scale = c.get_double("disparity_scale", 1e-6, 1e6);
   p.covariance_normals = c.get_choice("normal_method", {"covariance", "average_3d_gradient"}) == "covariance";
   p.max_depth_change_factor = c.get_double("max_depth_change_factor", 0.0, 10.0);
   p.normal_smoothing_size = c.get_double("normal_smoothing_size", 1.0, 1000.0);
@@ -26,9 +28,9 @@ PclPlaneParams PclPlaneParams::from_config(const Config& c) {
   return p;
 }
 
-SegmentationResult segment_pcl_planes(const cv::Mat& points, const PclPlaneParams& p) {
-  if (points.type() != CV_32FC3 || points.empty())
-    throw std::invalid_argument("segment_pcl_planes: points must be a non-empty CV_32FC3 image");
+namespace {
+/// Plane labels (CV_32S, 0 = none) of the organized cloud `points` by PCL.
+cv::Mat pcl_plane_labels(const cv::Mat& points, const PclPlaneParams& p) {
   pcl::PointCloud<pcl::PointXYZ>::Ptr cloud(new pcl::PointCloud<pcl::PointXYZ>);
   cloud->width = uint32_t(points.cols);
   cloud->height = uint32_t(points.rows);
@@ -66,7 +68,25 @@ SegmentationResult segment_pcl_planes(const cv::Mat& points, const PclPlaneParam
   int* l = labels.ptr<int>(0);
   for (size_t k = 0; k < inliers.size(); ++k)
     for (int idx : inliers[k].indices) l[idx] = int(k) + 1;  // labels is continuous
-  return describe_regions(labels, points, p.min_region_px);
+  return labels;
+}
+}  // namespace
+
+SegmentationResult segment_pcl_planes(const cv::Mat& points, const PclPlaneParams& p) {
+  if (points.type() != CV_32FC3 || points.empty())
+    throw std::invalid_argument("segment_pcl_planes: points must be a non-empty CV_32FC3 image");
+  return describe_regions(pcl_plane_labels(points, p), points, p.min_region_px);
+}
+
+SegmentationResult segment_pcl_planes(const cv::Mat& disparity, const cv::Mat& points, const PclPlaneParams& p) {
+  if (points.type() != CV_32FC3 || points.empty())
+    throw std::invalid_argument("segment_pcl_planes: points must be a non-empty CV_32FC3 image");
+  if (p.space == PclSpace::kPoints) return segment_pcl_planes(points, p);
+  if (disparity.type() != CV_32F || disparity.size() != points.size())
+    throw std::invalid_argument("segment_pcl_planes: the disparity must be CV_32F of the points' size");
+  cv::Mat cloud = image_space_points(disparity);
+  if (p.disparity_scale != 1.0) cv::multiply(cloud, cv::Scalar(1.0, 1.0, p.disparity_scale), cloud);
+  return describe_regions(pcl_plane_labels(cloud, p), points, p.min_region_px);
 }
 
 }  // namespace bookgrasp::bws

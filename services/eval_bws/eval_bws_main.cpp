@@ -87,7 +87,8 @@ int main(int argc, char** argv) {
   }
   if (scenes < 1 || seed < 0 || out_dir.empty()) return usage("--scenes, --seed and --out are required");
   if (config_file.empty())
-    config_file = in_source(impl == "god" ? "config/services/bws_detector.yaml" : "config/services/bws_detector_pcl.yaml");
+    config_file =
+        in_source(impl == "god" ? "config/services/bws_detector.yaml" : "config/services/bws_detector_pcl.yaml");
   if (!std::filesystem::exists(scene_file)) scene_file = in_source(scene_file);
 
   try {
@@ -117,12 +118,14 @@ int main(int argc, char** argv) {
         const auto& o = bws.last_output();
         std::cerr << "\nseed " << s << ": " << (r.failure.empty() ? "ok" : r.failure) << "\n";
         for (const auto& v : o.selection.regions) {
-          if (v.reason.rfind("too small", 0) == 0 || (v.reason.rfind("not parallel", 0) == 0 && v.inside_fraction < 0.5))
+          if (v.reason.rfind("too small", 0) == 0 ||
+              (v.reason.rfind("not parallel", 0) == 0 && v.inside_fraction < 0.5))
             continue;
           const auto& pr = o.segmentation.regions[size_t(v.label - 1)];
           std::cerr << "  region " << v.label << " px " << pr.pixel_count << " bbox " << pr.bbox << " inside "
                     << v.inside_fraction << " w " << v.width_m << " h " << v.height_m << " n_base "
                     << v.normal_base.transpose() << " : " << (v.candidate ? "CANDIDATE " : "") << v.reason << "\n";
+          if (!v.bands.empty()) std::cerr << "    bands: " << v.bands << "\n";
         }
       }
       if ((k < overlays || !r.found || r.wrong_book) && !overlay.empty())

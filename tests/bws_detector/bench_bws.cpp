@@ -3,6 +3,7 @@
 
 #include <benchmark/benchmark.h>
 
+#include "common/config.h"
 #include "services/bws_detector/book_front_selection.h"
 #include "services/bws_detector/disparity.h"
 #include "services/bws_detector/god_segmentation.h"
@@ -24,7 +25,7 @@ struct Input {
   StereoGeometry g;
   DisparityParams dp;
   GodParams gp;
-  PclPlaneParams pp;
+  PclPlaneParams pp, pp_metric;
   SelectionParams sp;
   Input() {
     left = test::render_boxes(scene.boxes, scene.left, true).intensity;
@@ -36,15 +37,17 @@ struct Input {
     gp.window_size = 5;
     gp.jump_mgod_min = 0.6;
     gp.min_region_px = 30;
-    pp.min_inliers = 30;
-    pp.normal_smoothing_size = 5.0;
-    pp.max_depth_change_factor = 0.01;
-    pp.angular_threshold_deg = 5.0;
-    pp.distance_threshold_m = 0.01;
-    pp.maximum_curvature = 0.01;
-    pp.min_region_px = 30;
-    sp.max_width_m = 0.06;
-    sp.max_height_m = 0.35;
+    pp_metric.min_inliers = 30;  // the metric-space PCL segmentation shipped until 2026-12-02
+    pp_metric.normal_smoothing_size = 5.0;
+    pp_metric.max_depth_change_factor = 0.01;
+    pp_metric.angular_threshold_deg = 5.0;
+    pp_metric.distance_threshold_m = 0.01;
+    pp_metric.maximum_curvature = 0.01;
+    pp_metric.min_region_px = 30;
+    // The shipped PCL segmentation and book-front selection (every PI refinement on).
+    const std::string dir = std::string(BOOKGRASP_SOURCE_DIR) + "/config/services/";
+    pp = PclPlaneParams::from_config(bookgrasp::Config::load_file(dir + "bws_detector_pcl.yaml").child("pcl"));
+    sp = SelectionParams::from_config(bookgrasp::Config::load_file(dir + "bws_detector.yaml").child("selection"));
   }
 };
 Input& input() {
@@ -88,9 +91,15 @@ BENCHMARK(BM_BookFrontSelection)->Unit(benchmark::kMillisecond);
 
 static void BM_PclSegmentation(benchmark::State& s) {
   auto& in = input();
-  for (auto _ : s) benchmark::DoNotOptimize(segment_pcl_planes(in.points, in.pp));
+  for (auto _ : s) benchmark::DoNotOptimize(segment_pcl_planes(in.disparity, in.points, in.pp));
 }
 BENCHMARK(BM_PclSegmentation)->Unit(benchmark::kMillisecond);
+
+static void BM_PclSegmentation_MetricSpace(benchmark::State& s) {
+  auto& in = input();
+  for (auto _ : s) benchmark::DoNotOptimize(segment_pcl_planes(in.points, in.pp_metric));
+}
+BENCHMARK(BM_PclSegmentation_MetricSpace)->Unit(benchmark::kMillisecond);
 
 static void whole(benchmark::State& s, bool god) {
   auto& in = input();
@@ -99,7 +108,7 @@ static void whole(benchmark::State& s, bool god) {
   for (auto _ : s) {
     const cv::Mat d = compute_disparity(in.left, in.right, in.dp);
     const cv::Mat p = disparity_to_points(d, in.g);
-    const SegmentationResult seg = god ? segment_god(d, p, in.gp) : segment_pcl_planes(p, in.pp);
+    const SegmentationResult seg = god ? segment_god(d, p, in.gp) : segment_pcl_planes(d, p, in.pp);
     benchmark::DoNotOptimize(select_book_front(seg, p, in.g, in.scene.left.in_base, shelf, in.sp));
   }
   s.counters["faults"] = benchmark::Counter((minor_faults() - f0) / double(s.iterations()));

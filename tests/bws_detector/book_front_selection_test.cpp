@@ -39,6 +39,84 @@ TEST(UpperRightCorner, FallsBackToTheNearestRegionPixel) {
   EXPECT_THROW(upper_right_corner(l, 99), std::invalid_argument);
 }
 
+TEST(RightColumnTop, TheRightmostBooksOwnTopNotATallerNeighbours) {
+  // One region of two fronts: a tall one (x 2..5, rows 2..19) and a short one right of it (x 6..8,
+  // rows 9..19), plus two stray pixels in column 9. The paper's corner (Y_min 2, X_max 9) is outside
+  // the region; its nearest pixel is the tall front's (5, 2). The right-most well-filled column is 8
+  // (column 9 holds 2 of the fullest column's 18), whose top is row 9.
+  cv::Mat l(24, 14, CV_32S, cv::Scalar(0));
+  l(cv::Rect(2, 2, 4, 18)).setTo(4);
+  l(cv::Rect(6, 9, 3, 11)).setTo(4);
+  l.at<int>(12, 9) = 4;
+  l.at<int>(15, 9) = 4;
+  EXPECT_EQ(upper_right_corner(l, 4), cv::Point(5, 2));
+  EXPECT_EQ(right_column_top(l, 4), cv::Point(8, 9));
+  // A single stray pixel on top of column 8 (its lower neighbour not in the region) is not the top.
+  l.at<int>(6, 8) = 4;
+  EXPECT_EQ(right_column_top(l, 4), cv::Point(8, 9));
+  EXPECT_THROW(right_column_top(l, 99), std::invalid_argument);
+  EXPECT_THROW(right_column_top(cv::Mat(4, 4, CV_8U, cv::Scalar(0)), 1), std::invalid_argument);
+}
+
+// Camera at the origin looking along +z (fx = fy = 500, cx = 20, cy = 20, baseline 0.1 m): rows 0..4 see
+// a wall at z = 5 m, rows 5..39 a front at z = 2 m; the region holds rows 12..39 of columns 10..15.
+struct FrontAboveItsRegion {
+  StereoGeometry g{500.0, 500.0, 20.0, 20.0, 0.1};
+  cv::Mat labels = cv::Mat(40, 40, CV_32S, cv::Scalar(0));
+  cv::Mat points = cv::Mat(40, 40, CV_32FC3);
+  Eigen::Vector3d normal{0.0, 0.0, -1.0};  // towards the camera
+  double offset = -2.0;
+  FrontAboveItsRegion() {
+    for (int y = 0; y < 40; ++y)
+      for (int x = 0; x < 40; ++x) {
+        const double z = y < 5 ? 5.0 : 2.0;
+        points.at<cv::Vec3f>(y, x) = cv::Vec3f(float((x - g.cx) * z / g.fx), float((y - g.cy) * z / g.fy), float(z));
+      }
+    labels(cv::Rect(10, 12, 6, 28)).setTo(1);
+  }
+};
+
+TEST(RaiseToPlaneTop, ClimbsTheFrontsRowsUpToItsEdge) {
+  FrontAboveItsRegion f;
+  const cv::Point pi(15, 12);
+  EXPECT_EQ(raise_to_plane_top(f.labels, 1, pi, f.points, f.normal, f.offset, f.g, 0.5, 30, 1, 3), cv::Point(15, 5));
+  // At most max_px rows.
+  EXPECT_EQ(raise_to_plane_top(f.labels, 1, pi, f.points, f.normal, f.offset, f.g, 0.5, 4, 1, 3), cv::Point(15, 8));
+  // One pixel without depth is bridged with max_gap_px 1, two are not (but are with 2).
+  f.points.at<cv::Vec3f>(9, 15) = cv::Vec3f(NAN, NAN, NAN);
+  EXPECT_EQ(raise_to_plane_top(f.labels, 1, pi, f.points, f.normal, f.offset, f.g, 0.5, 30, 1, 1), cv::Point(15, 5));
+  f.points.at<cv::Vec3f>(8, 15) = cv::Vec3f(NAN, NAN, NAN);
+  EXPECT_EQ(raise_to_plane_top(f.labels, 1, pi, f.points, f.normal, f.offset, f.g, 0.5, 30, 1, 1), cv::Point(15, 10));
+  EXPECT_EQ(raise_to_plane_top(f.labels, 1, pi, f.points, f.normal, f.offset, f.g, 0.5, 30, 2, 1), cv::Point(15, 5));
+  // The median of three columns: 15 stops at 10, 14 and 13 reach 5.
+  EXPECT_EQ(raise_to_plane_top(f.labels, 1, pi, f.points, f.normal, f.offset, f.g, 0.5, 30, 1, 3), cv::Point(15, 5));
+}
+
+TEST(RaiseToPlaneTop, BridgesAStereoOutlier) {
+  FrontAboveItsRegion f;
+  f.points.at<cv::Vec3f>(9, 15) *= 1.5f;  // 3 m instead of 2 m: 8.3 px off the plane
+  EXPECT_EQ(raise_to_plane_top(f.labels, 1, {15, 12}, f.points, f.normal, f.offset, f.g, 0.5, 30, 1, 1),
+            cv::Point(15, 5));
+  EXPECT_EQ(raise_to_plane_top(f.labels, 1, {15, 12}, f.points, f.normal, f.offset, f.g, 0.5, 30, 0, 1),
+            cv::Point(15, 10));
+}
+
+TEST(RaiseToPlaneTop, StopsWhereTheDepthLeavesThePlane) {
+  FrontAboveItsRegion f;
+  // Rows 5..8 of column 15 at 2.1 m: 500 * 0.1 * (1/2 - 1/2.1) = 1.19 px off the plane.
+  for (int y = 5; y <= 8; ++y) f.points.at<cv::Vec3f>(y, 15) *= float(2.1 / 2.0);
+  EXPECT_EQ(raise_to_plane_top(f.labels, 1, {15, 12}, f.points, f.normal, f.offset, f.g, 0.5, 30, 1, 1),
+            cv::Point(15, 9));
+  EXPECT_EQ(raise_to_plane_top(f.labels, 1, {15, 12}, f.points, f.normal, f.offset, f.g, 1.5, 30, 1, 1),
+            cv::Point(15, 5));
+  // Never lower than PI, whatever the columns say.
+  EXPECT_EQ(raise_to_plane_top(f.labels, 1, {15, 3}, f.points, f.normal, f.offset, f.g, 0.5, 30, 1, 1),
+            cv::Point(15, 3));
+  EXPECT_THROW(
+      raise_to_plane_top(f.labels, 1, {15, 12}, cv::Mat(3, 3, CV_32FC3), f.normal, f.offset, f.g, 0.5, 30, 1, 1),
+      std::invalid_argument);
+}
+
 SelectionParams selection_params() {
   SelectionParams p;
   p.parallel_tolerance_deg = 15;
@@ -79,12 +157,12 @@ struct Outcome {
 
 // Runs segmentation + selection on one scene; `disparity` from exact depth or from StereoBM.
 BookFrontResult detect(const test::ShelfScene& scene, const cv::Mat& disparity, const test::RenderOutput& ren,
-                       bool* right_book) {
+                       bool* right_book, const SelectionParams& params = selection_params()) {
   const StereoGeometry g{scene.left.fx, scene.left.fy, scene.left.cx, scene.left.cy, scene.baseline_m};
   const cv::Mat pts = disparity_to_points(disparity, g);
   const SegmentationResult seg = segment_god(disparity, pts, god_params());
   ShelfVolume shelf{scene.shelf_box_in_base, scene.shelf_half_extent};
-  BookFrontResult r = select_book_front(seg, pts, g, scene.left.in_base, shelf, selection_params());
+  BookFrontResult r = select_book_front(seg, pts, g, scene.left.in_base, shelf, params);
   if (right_book && r.found) {
     // The selected region must be mostly the right-most book's front face (truth used only here).
     const int face = scene.rightmost_book * 6 + test::kFaceMinusX + 1;
@@ -138,12 +216,19 @@ TEST(SelectBookFront, ExactDisparityP1WithinAFewMillimetres) {
 // End to end from textured stereo renders through StereoBM. At ~1.4 m a 1-3.5 cm book front is 4-14 px
 // wide: StereoBM smears it with the grazing side face, and the plane of so narrow a region is poorly
 // determined about the vertical axis, so the right-most front is often dropped as "not parallel"
-// (measured: right book in 1 of these 3 scenes, P1 error -1.8/1.0/-18.1 mm in base there: the top rows of
-// the front are lost to StereoBM smearing). What must hold: a P1 is found on the front of a book (never the
-// cart), and when it is the right book it is within 2.5 cm (the hand camera refines it, paper Section 3).
+// (measured: right book in 1 of these 3 scenes, P1 error in base there -1.8/1.0/-18.1 mm with the paper's PI,
+// -1.9/5.2/8.0 mm with the shipped PI refinements: the top rows of the front are lost to StereoBM smearing). What must
+// hold: a P1 is found on the front of a book (never the cart), and when it is the right book it is within 2.5 cm (the
+// hand camera refines it, paper Section 3).
 TEST(SelectBookFront, StereoBmDisparitySelectsABookFront) {
   DisparityParams dp;  // StereoBM as in config/services/bws_detector.yaml
   dp.block_size = 7;
+  SelectionParams sp = selection_params();  // and its PI refinements
+  sp.top_growth_px = 80;
+  sp.top_growth_disparity_px = 0.75;
+  sp.top_growth_max_gap_px = 5;
+  sp.top_growth_columns = 3;
+  sp.edge_fattening_px = 2.0;
   int right_count = 0;
   for (uint32_t seed : {1u, 2u, 3u}) {
     const test::ShelfScene scene = test::make_shelf_scene(seed);
@@ -151,7 +236,7 @@ TEST(SelectBookFront, StereoBmDisparitySelectsABookFront) {
     const test::RenderOutput R = test::render_boxes(scene.boxes, scene.right, true);
     const cv::Mat disp = compute_disparity(L.intensity, R.intensity, dp);
     bool right = false;
-    const BookFrontResult r = detect(scene, disp, L, &right);
+    const BookFrontResult r = detect(scene, disp, L, &right, sp);
     ASSERT_TRUE(r.found) << "seed " << seed << ": " << r.failure_reason;
     const Eigen::Vector3d err = r.p1_base - scene.true_corner_base;
     std::printf("StereoBM seed %u: P1 error base (mm) %.1f %.1f %.1f, right book %d\n", seed, 1e3 * err.x(),
@@ -159,8 +244,8 @@ TEST(SelectBookFront, StereoBmDisparitySelectsABookFront) {
     // The selected region's pixels are mostly the front face of some book.
     std::map<int, int> faces;
     int all = 0;
-    const cv::Mat pts = disparity_to_points(disp, StereoGeometry{scene.left.fx, scene.left.fy, scene.left.cx,
-                                                                  scene.left.cy, scene.baseline_m});
+    const cv::Mat pts = disparity_to_points(
+        disp, StereoGeometry{scene.left.fx, scene.left.fy, scene.left.cx, scene.left.cy, scene.baseline_m});
     const SegmentationResult seg = segment_god(disp, pts, god_params());
     for (int y = 0; y < seg.labels.rows; ++y)
       for (int x = 0; x < seg.labels.cols; ++x)

@@ -1,4 +1,6 @@
 // The shipped configuration files load completely (every key read, none unknown) and bad values name the key.
+#include <fstream>
+#include <iterator>
 #include <string>
 
 #include <gtest/gtest.h>
@@ -39,8 +41,9 @@ TEST(BwsConfig, PclFileLoadsCompletely) {
 }
 
 TEST(BwsConfig, BadCartGeometryNamesTheKey) {
-  std::string yaml = "cart: {marker_role: cart, marker_in_cart_m: [0.359, 0.3, 0.37], upper_shelf_min_m: [0, -0.4, 0], "
-                     "upper_shelf_max_m: [0.34, 0.4, 0.33], max_marker_age_s: 1.0}";
+  std::string yaml =
+      "cart: {marker_role: cart, marker_in_cart_m: [0.359, 0.3, 0.37], upper_shelf_min_m: [0, -0.4, 0], "
+      "upper_shelf_max_m: [0.34, 0.4, 0.33], max_marker_age_s: 1.0}";
   EXPECT_NO_THROW(CartGeometry::from_config(Config::from_string(yaml, "t.yaml").child("cart")));
   std::string bad = yaml;
   bad.replace(bad.find("[0.34, 0.4, 0.33]"), 17, "[0.34, -0.5, 0.33]");
@@ -75,6 +78,37 @@ TEST(BwsConfig, BadValuesNameTheKey) {
   bad = ok;
   bad.replace(bad.find(", min_region_px: 30"), 19, "");
   EXPECT_NE(err(bad).find("min_region_px"), std::string::npos);
+}
+
+TEST(BwsConfig, BadSelectionValuesNameTheKey) {
+  const auto err = [](const std::string& text) {
+    try {
+      SelectionParams::from_config(Config::from_string(text, "test.yaml").child("selection"));
+    } catch (const ConfigError& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  std::string ok;
+  {
+    std::ifstream f(kDir + "bws_detector.yaml");
+    ok.assign(std::istreambuf_iterator<char>(f), std::istreambuf_iterator<char>());
+  }
+  EXPECT_EQ(err(ok), "");
+  const auto replaced = [&](const std::string& from, const std::string& to) {
+    std::string t = ok;
+    const size_t at = t.find(from);
+    EXPECT_NE(at, std::string::npos) << from;
+    return at == std::string::npos ? t : t.replace(at, from.size(), to);
+  };
+  EXPECT_NE(err(replaced("pi_rule: right_column_top", "pi_rule: leftmost")).find("pi_rule"), std::string::npos);
+  EXPECT_NE(err(replaced("top_growth_px: 80", "top_growth_px: -1")).find("top_growth_px"), std::string::npos);
+  EXPECT_NE(
+      err(replaced("top_growth_disparity_px: 0.75", "top_growth_disparity_px: nan")).find("top_growth_disparity_px"),
+      std::string::npos);
+  EXPECT_NE(err(replaced("top_growth_columns: 3", "top_growth_columns: 0")).find("top_growth_columns"),
+            std::string::npos);
+  EXPECT_NE(err(replaced("  top_growth_columns: 3", "  # gone")).find("top_growth_columns"), std::string::npos);
 }
 
 }  // namespace
