@@ -55,15 +55,19 @@ TEST(BwsConfig, BadCartGeometryNamesTheKey) {
   }
 }
 
+/// The ConfigError message of Params::from_config on `section` of the YAML text; empty when it loads.
+template <typename Params>
+std::string config_error(const std::string& yaml, const std::string& section) {
+  try {
+    Params::from_config(Config::from_string(yaml, "test.yaml").child(section));
+  } catch (const ConfigError& e) {
+    return e.what();
+  }
+  return "";
+}
+
 TEST(BwsConfig, BadValuesNameTheKey) {
-  const auto err = [](const std::string& yaml) {
-    try {
-      GodParams::from_config(Config::from_string(yaml, "test.yaml").child("god"));
-    } catch (const ConfigError& e) {
-      return std::string(e.what());
-    }
-    return std::string();
-  };
+  const auto err = [](const std::string& yaml) { return config_error<GodParams>(yaml, "god"); };
   const std::string ok =
       "god: {gradient_step: 1, direction_bins: 16, flat_mgod_max: 0.0, window_size: 5, jump_mgod_min: 0.6, "
       "merge_distance: 0.75, merge_space: image, merge_max_angle_deg: 30, merge_angle_min_px: 100, "
@@ -81,14 +85,7 @@ TEST(BwsConfig, BadValuesNameTheKey) {
 }
 
 TEST(BwsConfig, BadSelectionValuesNameTheKey) {
-  const auto err = [](const std::string& text) {
-    try {
-      SelectionParams::from_config(Config::from_string(text, "test.yaml").child("selection"));
-    } catch (const ConfigError& e) {
-      return std::string(e.what());
-    }
-    return std::string();
-  };
+  const auto err = [](const std::string& text) { return config_error<SelectionParams>(text, "selection"); };
   std::string ok;
   {
     std::ifstream f(kDir + "bws_detector.yaml");
