@@ -222,7 +222,7 @@ TEST_F(BwsNodeBadInput, MissingCartMarker) {
 
 TEST_F(BwsNodeBadInput, StaleCartMarker) {
   marker_detections_t old = fixture().markers;
-  old.utime = fixture().frame.utime - 60000000;  // 60 s before the frame, limit 10 s
+  old.utime = fixture().frame.utime - 60000000;  // 60 s before the frame, limit 30 s
   comp.bus().publish("MARKERS", &old);
   marker_detections_t none_now = fixture().markers;  // the detector's answer for the frame: no cart marker
   none_now.markers.clear();
