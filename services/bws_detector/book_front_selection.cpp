@@ -111,12 +111,11 @@ cv::Point raise_to_plane_top(const cv::Mat& labels, int label, cv::Point pi, con
     const int start = top;
     for (int y = start - 1; y >= 0 && start - y <= max_px; --y) {
       const cv::Vec3f q = points_camera.at<cv::Vec3f>(y, x);
-      const Eigen::Vector3d ray((x - g.cx) / g.fx, (y - g.cy) / g.fy, 1.0);
-      const double denom = normal.dot(ray);
       if (!std::isfinite(q[2]) || q[2] <= 0.0f) {
         if (++gap > max_gap_px) break;
         continue;
       }
+      const double denom = normal.dot(Eigen::Vector3d((x - g.cx) / g.fx, (y - g.cy) / g.fy, 1.0));
       if (std::fabs(denom) < 1e-9) break;
       const double z_plane = offset / denom;
       if (!(z_plane > 0.0) || std::fabs(fb / q[2] - fb / z_plane) > tolerance_px) {
@@ -273,7 +272,7 @@ BookFrontResult select_book_front(const SegmentationResult& seg, const cv::Mat& 
   const Eigen::Vector3d shelf_n = shelf.box_in_base.linear().col(2);
   const double cos_par = std::cos(p.parallel_tolerance_deg * M_PI / 180.0);
   const double sin_perp = std::sin(p.perpendicular_tolerance_deg * M_PI / 180.0);
-  const auto in_volume = [&](const Eigen::Vector3f& q) {
+  const auto in_volume = [&](const auto& q) {  // q in the shelf box frame, float or double
     return std::fabs(q.x()) <= shelf.half_extent.x() && std::fabs(q.y()) <= shelf.half_extent.y() &&
            std::fabs(q.z()) <= shelf.half_extent.z();
   };
@@ -307,10 +306,7 @@ BookFrontResult select_book_front(const SegmentationResult& seg, const cv::Mat& 
       int* o = mask.ptr<int>(y);
       for (int x = r.bbox.x; x < r.bbox.x + r.bbox.width; ++x) {
         if (l[x] != r.label || !point_ok(q[x])) continue;
-        const Eigen::Vector3d qb = cam_in_box * measured_point(r, x, y, q[x]);
-        if (std::fabs(qb.x()) <= shelf.half_extent.x() && std::fabs(qb.y()) <= shelf.half_extent.y() &&
-            std::fabs(qb.z()) <= shelf.half_extent.z())
-          o[x] = r.label;
+        if (in_volume(cam_in_box * measured_point(r, x, y, q[x]))) o[x] = r.label;
       }
     }
   };

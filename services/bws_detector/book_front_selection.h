@@ -171,8 +171,8 @@ cv::Point right_column_top(const cv::Mat& labels, int label);
 /// above are taken while the pixel's disparity (fx B / z of `points_camera`) is within `tolerance_px`
 /// of the disparity of the plane { p : normal . p = offset } (left camera frame, metres) on that
 /// pixel's ray, up to `max_gap_px` pixels in a row without depth or off the plane bridged (StereoBM
-/// leaves holes and outliers on a narrow front), at most `max_px` rows; the
-/// result keeps pi.x and takes the median of the columns' tops (never lower than pi.y).
+/// leaves holes and outliers on a narrow front), at most `max_px` rows; the result keeps pi.x and
+/// takes the median of the columns' tops (never lower than pi.y).
 cv::Point raise_to_plane_top(const cv::Mat& labels, int label, cv::Point pi, const cv::Mat& points_camera,
                              const Eigen::Vector3d& normal, double offset, const StereoGeometry& geometry,
                              double tolerance_px, int max_px, int max_gap_px, int columns);

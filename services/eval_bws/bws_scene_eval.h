@@ -16,6 +16,7 @@
 
 #include "bookgrasp/ground_truth_t.hpp"
 #include "bookgrasp/stereo_frame_t.hpp"
+#include "common/sim_render/pinhole_camera.h"
 
 namespace bookgrasp {
 class BwsDetectorNode;
@@ -65,6 +66,8 @@ struct RenderedScene {
   stereo_frame_t frame;
   /// Owner image of the left camera (book id >= 0 or a negative GeomOwner code).
   cv::Mat owner;
+  /// The left camera at capture (to draw truth into its image).
+  sim_render::PinholeCamera left_camera;
   /// Ground truth at capture.
   ground_truth_t truth;
 };
