@@ -66,6 +66,19 @@ std::string config_error(const std::string& yaml, const std::string& section) {
   return "";
 }
 
+/// The text of a shipped configuration file.
+std::string shipped_text(const std::string& file) {
+  std::ifstream f(kDir + file);
+  return std::string(std::istreambuf_iterator<char>(f), std::istreambuf_iterator<char>());
+}
+
+/// `text` with the first `from` replaced by `to` (a test failure if `from` is absent).
+std::string replaced(std::string text, const std::string& from, const std::string& to) {
+  const size_t at = text.find(from);
+  EXPECT_NE(at, std::string::npos) << from;
+  return at == std::string::npos ? text : text.replace(at, from.size(), to);
+}
+
 TEST(BwsConfig, BadValuesNameTheKey) {
   const auto err = [](const std::string& yaml) { return config_error<GodParams>(yaml, "god"); };
   const std::string ok =
@@ -86,26 +99,25 @@ TEST(BwsConfig, BadValuesNameTheKey) {
 
 TEST(BwsConfig, BadSelectionValuesNameTheKey) {
   const auto err = [](const std::string& text) { return config_error<SelectionParams>(text, "selection"); };
-  std::string ok;
-  {
-    std::ifstream f(kDir + "bws_detector.yaml");
-    ok.assign(std::istreambuf_iterator<char>(f), std::istreambuf_iterator<char>());
-  }
+  const std::string ok = shipped_text("bws_detector.yaml");
   EXPECT_EQ(err(ok), "");
-  const auto replaced = [&](const std::string& from, const std::string& to) {
-    std::string t = ok;
-    const size_t at = t.find(from);
-    EXPECT_NE(at, std::string::npos) << from;
-    return at == std::string::npos ? t : t.replace(at, from.size(), to);
-  };
-  EXPECT_NE(err(replaced("pi_rule: right_column_top", "pi_rule: leftmost")).find("pi_rule"), std::string::npos);
-  EXPECT_NE(err(replaced("top_growth_px: 80", "top_growth_px: -1")).find("top_growth_px"), std::string::npos);
-  EXPECT_NE(
-      err(replaced("top_growth_disparity_px: 0.75", "top_growth_disparity_px: nan")).find("top_growth_disparity_px"),
-      std::string::npos);
-  EXPECT_NE(err(replaced("top_growth_columns: 3", "top_growth_columns: 0")).find("top_growth_columns"),
+  EXPECT_NE(err(replaced(ok, "pi_rule: right_column_top", "pi_rule: leftmost")).find("pi_rule"), std::string::npos);
+  EXPECT_NE(err(replaced(ok, "top_growth_px: 80", "top_growth_px: -1")).find("top_growth_px"), std::string::npos);
+  EXPECT_NE(err(replaced(ok, "top_growth_disparity_px: 0.75", "top_growth_disparity_px: nan"))
+                .find("top_growth_disparity_px"),
             std::string::npos);
-  EXPECT_NE(err(replaced("  top_growth_columns: 3", "  # gone")).find("top_growth_columns"), std::string::npos);
+  EXPECT_NE(err(replaced(ok, "top_growth_columns: 3", "top_growth_columns: 0")).find("top_growth_columns"),
+            std::string::npos);
+  EXPECT_NE(err(replaced(ok, "  top_growth_columns: 3", "  # gone")).find("top_growth_columns"), std::string::npos);
+}
+
+TEST(BwsConfig, BadPclSpaceValuesNameTheKey) {
+  const auto err = [](const std::string& text) { return config_error<PclPlaneParams>(text, "pcl"); };
+  const std::string ok = shipped_text("bws_detector_pcl.yaml");
+  EXPECT_EQ(err(ok), "");
+  EXPECT_NE(err(replaced(ok, "space: image", "space: metres")).find("space"), std::string::npos);
+  EXPECT_NE(err(replaced(ok, "disparity_scale: 1.0", "disparity_scale: 0")).find("disparity_scale"), std::string::npos);
+  EXPECT_NE(err(replaced(ok, "  disparity_scale: 1.0", "  # gone")).find("disparity_scale"), std::string::npos);
 }
 
 }  // namespace
