@@ -37,6 +37,7 @@ CycleGeometry CycleGeometry::from_config(const Config& c) {
   g.grasp_offset_y = c.get_double("grasp.offset_y_m", -0.1, 0.1);
   g.insertion_depth = c.get_double("grasp.insertion_depth_m", 0.0, 0.2);
   g.pre_grasp_distance = c.get_double("grasp.pre_grasp_distance_m", 0.01, 0.5);
+  g.deep_front_z = c.get_double("grasp.deep_front_z_m", -0.2, 0.36);
   g.extract_lift = c.get_double("grasp.extract_lift_m", 0.0, 0.5);
   g.extract_retreat = c.get_double("grasp.extract_retreat_m", 0.0, 1.0);
   g.holder_support_in_marker = vec3(c, "holder.support_origin_in_marker_m");
@@ -126,8 +127,13 @@ Eigen::Isometry3d grasp_pose(const Eigen::Isometry3d& gp, const CycleGeometry& g
   return move_along_own_axes(gp, Eigen::Vector3d(g.grasp_offset_x, g.grasp_offset_y, g.insertion_depth));
 }
 
-Eigen::Isometry3d pre_grasp_pose(const Eigen::Isometry3d& gp, const CycleGeometry& g) {
-  return move_along_own_axes(gp, Eigen::Vector3d(g.grasp_offset_x, g.grasp_offset_y, -g.pre_grasp_distance));
+double moves_front_z(double gp_z, const CycleGeometry& g) {
+  return std::min(gp_z, g.deep_front_z);
+}
+
+Eigen::Isometry3d pre_grasp_pose(const Eigen::Isometry3d& gp, double gp_z, const CycleGeometry& g) {
+  const double back = g.pre_grasp_distance + (gp_z - moves_front_z(gp_z, g));
+  return move_along_own_axes(gp, Eigen::Vector3d(g.grasp_offset_x, g.grasp_offset_y, -back));
 }
 
 double tcp_height_on_book(const Eigen::Vector3d& gp_grasp, const CycleGeometry& g) {

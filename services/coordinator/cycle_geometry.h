@@ -36,6 +36,10 @@ struct CycleGeometry {
   double grasp_offset_y = 0.0;      ///< TCP right (+) of GP along Y
   double insertion_depth = 0.02;    ///< TCP this far beyond GP along Z
   double pre_grasp_distance = 0.10; ///< pre-grasp pose this far in front of GP along -Z
+  /// Deepest GP (grasp Z) the pre-grasp and the extraction's end are measured from: a deeper front (books
+  /// pushed back by an earlier grasp's left plate) gets the pre-grasp and the extraction's end a front at this
+  /// depth would get: the plates in front of the planner's books box, the held book's box off the rear board.
+  double deep_front_z = 0.035;
   double extract_lift = 0.01;       ///< first lift along the gripper x after the grasp
   double extract_retreat = 0.40;    ///< then straight out along the gripper -z
   // holder
@@ -76,8 +80,12 @@ Eigen::Isometry3d bwh_start_pose(const Eigen::Isometry3d& grasp_frame, const Eig
                                  const CycleGeometry& g);
 /// TCP pose that grasps the book: GP's gripper pose shifted by the offsets and the insertion depth.
 Eigen::Isometry3d grasp_pose(const Eigen::Isometry3d& gp_base, const CycleGeometry& g);
-/// Pre-grasp pose: the grasp pose moved back along its z to `pre_grasp_distance` in front of GP.
-Eigen::Isometry3d pre_grasp_pose(const Eigen::Isometry3d& gp_base, const CycleGeometry& g);
+/// GP's grasp Z as the moves around the grasp see it: min(gp_z, deep_front_z).
+double moves_front_z(double gp_z, const CycleGeometry& g);
+
+/// Pre-grasp pose: the grasp pose moved back along its z to `pre_grasp_distance` in front of GP, or in front
+/// of grasp Z `deep_front_z` when GP lies deeper (`gp_z`: GP's grasp Z, into the shelf).
+Eigen::Isometry3d pre_grasp_pose(const Eigen::Isometry3d& gp_base, double gp_z, const CycleGeometry& g);
 /// Book height above its support at the TCP: GP.x (top above the upper shelf) plus the X offset.
 double tcp_height_on_book(const Eigen::Vector3d& gp_grasp, const CycleGeometry& g);
 /// TCP height above the book's bottom for the grasp from the holder: `tcp_height` (the grasp from the shelf)

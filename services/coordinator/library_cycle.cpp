@@ -669,7 +669,7 @@ void LibraryCycle::enter(CycleState s) {
       }
       break;
     case CycleState::kMoveToPreGrasp:
-      start_planned_pose(pre_grasp_pose(gp_base_, g), false);
+      start_planned_pose(pre_grasp_pose(gp_base_, progress_.gp_grasp.z(), g), false);
       break;
     case CycleState::kOpenForGrasp:
     case CycleState::kOpenForHolderGrasp:
@@ -685,8 +685,8 @@ void LibraryCycle::enter(CycleState s) {
       start_gripper(true);
       break;
     case CycleState::kExtract: {
-      start_linear(
-          extract_moves(arm_->end_effector, cart_frame(), tcp_height(), progress_.gp_grasp.z() + g.insertion_depth, g));
+      start_linear(extract_moves(arm_->end_effector, cart_frame(), tcp_height(),
+                                 moves_front_z(progress_.gp_grasp.z(), g) + g.insertion_depth, g));
       break;
     }
     case CycleState::kMoveToHolder:

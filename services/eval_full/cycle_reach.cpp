@@ -57,7 +57,7 @@ std::vector<StageReach> cycle_reach(const scene::Scene& scene, const CycleGeomet
                      pose_in_grasp_frame(grasp, Eigen::Vector3d(g.stripe_start.x(), se.y(), g.stripe_start.z())));
   poses.emplace_back("bwh_start", bwh_start_pose(grasp, p1, g));
   const Eigen::Isometry3d gp = pose_in_grasp_frame(grasp, p1);
-  poses.emplace_back("pre_grasp", pre_grasp_pose(gp, g));
+  poses.emplace_back("pre_grasp", pre_grasp_pose(gp, p1.z(), g));
   const Eigen::Isometry3d gr = grasp_pose(gp, g);
   poses.emplace_back("grasp", gr);
   poses.emplace_back("extract_lift", move_along_own_axes(gr, Eigen::Vector3d(g.extract_lift, 0, 0)));

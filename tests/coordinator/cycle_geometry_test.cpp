@@ -30,6 +30,34 @@ TEST(CycleGeometry, TheCornerServoStandoffReachesTheBooksFront) {
   EXPECT_NEAR(servo_standoff(-0.5, g), 0.02, 1e-12);  // never closer than 2 cm
 }
 
+TEST(CycleGeometry, APushedBackFrontKeepsThePreGraspInFrontOfTheShelf) {
+  CycleGeometry g = geometry();
+  g.pre_grasp_distance = 0.09;
+  g.deep_front_z = 0.035;
+  g.grasp_offset_x = -0.01;
+  g.grasp_offset_y = 0.015;
+  // GP frame rotated: its z (into the shelf) along base +x, its x (up) along base +z.
+  Eigen::Isometry3d gp = Eigen::Isometry3d::Identity();
+  gp.linear().col(0) = Eigen::Vector3d(0, 0, 1);
+  gp.linear().col(1) = Eigen::Vector3d(0, -1, 0);
+  gp.linear().col(2) = Eigen::Vector3d(1, 0, 0);
+  gp.translation() = Eigen::Vector3d(0.80, -0.20, 0.20);
+  // A front at 2 cm: 9 cm straight back along -z, offsets along x (up) and y.
+  const Eigen::Vector3d usual = pre_grasp_pose(gp, 0.02, g).translation();
+  EXPECT_NEAR(usual.x(), 0.80 - 0.09, 1e-12);
+  EXPECT_NEAR(usual.y(), -0.20 - 0.015, 1e-12);
+  EXPECT_NEAR(usual.z(), 0.20 - 0.01, 1e-12);
+  // At the limit nothing changes; a front pushed back to 9 cm keeps the pre-grasp of a front at 3.5 cm.
+  EXPECT_NEAR(pre_grasp_pose(gp, 0.035, g).translation().x(), 0.80 - 0.09, 1e-12);
+  gp.translation().x() = 0.80 + 0.055;  // GP 5.5 cm deeper: Z 0.09
+  const Eigen::Isometry3d deep = pre_grasp_pose(gp, 0.09, g);
+  EXPECT_NEAR(deep.translation().x(), 0.80 + 0.055 - 0.09 - 0.055, 1e-12);
+  EXPECT_TRUE(deep.linear().isApprox(gp.linear()));
+  // The extraction ends where it ends for a front at the limit too.
+  EXPECT_NEAR(moves_front_z(0.09, g), 0.035, 1e-12);
+  EXPECT_NEAR(moves_front_z(0.012, g), 0.012, 1e-12);
+}
+
 TEST(CycleGeometry, TheGraspFromTheHolderIsLowerAndTheBookHangsLessBelowTheTcp) {
   const CycleGeometry g = geometry();
   EXPECT_NEAR(holder_regrasp_height(0.25, g), 0.235, 1e-12);
