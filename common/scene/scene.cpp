@@ -237,6 +237,9 @@ Scene generate_scene(const Config& root, uint64_t seed, const std::string& base_
     const double back_t = hc.get_double("back_thickness_m", 0.002, 0.1);
     const double ledge = hc.get_double("ledge_depth_m", 0.01, 0.2);
     const double lip = hc.get_double("lip_height_m", 0.0, 0.1);
+    // The ledge (with its lip and leg) may reach beyond the back plate's right end (-y): a book placed there
+    // with the gripper's back finger beyond the plate stands on it with its whole bottom.
+    const double ext = hc.get_double("ledge_extension_right_m", 0.0, 0.5);
     const Eigen::Vector3d rgb = get_rgb(hc, "color_rgb");
     const Eigen::Isometry3d& H = s.holder_pose;
     s.boxes.push_back(box_in(H, "holder_base", "holder", {-base.x() / 2, -base.y() / 2, 0},
@@ -246,11 +249,11 @@ Scene generate_scene(const Config& root, uint64_t seed, const std::string& base_
     const Eigen::Vector3d edge(base.x() / 2 - 0.03 - back_h * std::sin(incline), 0, base.z() + ledge * std::sin(incline));
     const Eigen::Isometry3d P = H * make_pose(edge, rot_y(incline));
     s.boxes.push_back(box_in(P, "holder_back", "holder", {0, -base.y() / 2, 0}, {back_t, base.y() / 2, back_h}, rgb));
-    s.boxes.push_back(box_in(P, "holder_ledge", "holder", {-ledge, -base.y() / 2, -0.012}, {0, base.y() / 2, 0}, rgb));
-    s.boxes.push_back(
-        box_in(P, "holder_lip", "holder", {-ledge, -base.y() / 2, 0}, {-ledge + 0.008, base.y() / 2, lip}, rgb));
+    const double right = -base.y() / 2 - ext;
+    s.boxes.push_back(box_in(P, "holder_ledge", "holder", {-ledge, right, -0.012}, {0, base.y() / 2, 0}, rgb));
+    s.boxes.push_back(box_in(P, "holder_lip", "holder", {-ledge, right, 0}, {-ledge + 0.008, base.y() / 2, lip}, rgb));
     // Leg under the ledge down to the base plate.
-    s.boxes.push_back(box_in(H, "holder_leg", "holder", {edge.x() - ledge * std::cos(incline) - 0.01, -base.y() / 2, 0},
+    s.boxes.push_back(box_in(H, "holder_leg", "holder", {edge.x() - ledge * std::cos(incline) - 0.01, right, 0},
                              {edge.x(), base.y() / 2, edge.z() - 0.012}, rgb * 0.9));
     s.holder_support_pose = P;
     // Marker on the back plate's front face.

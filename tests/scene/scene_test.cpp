@@ -190,6 +190,41 @@ TEST(Scene, CamerasFollowTheConfiguration) {
   EXPECT_LT(dist, 1.7);
 }
 
+TEST(Scene, TheHoldersLedgeReachesBeyondTheBackPlatesRightEnd) {
+  std::string yaml = read_file(kScene);
+  const auto pos = yaml.find("ledge_extension_right_m: ");
+  ASSERT_NE(pos, std::string::npos);
+  const auto end = yaml.find_first_of(" \n", pos + 25);
+  for (const double ext : {0.0, 0.1}) {
+    std::string y = yaml;
+    y.replace(pos, end - pos, "ledge_extension_right_m: " + std::to_string(ext));
+    const Scene s = generate_scene(Config::from_string(y, "test.yaml"), 1, std::string(BOOKGRASP_SOURCE_DIR) + "/config/scenes");
+    // Right ends (-y of the holder frame) of the back plate and the ledge, and the ledge's left end.
+    const auto y_range = [&](const std::string& name) {
+      for (const StaticBox& b : s.boxes)
+        if (b.name == name) {
+          const Eigen::Isometry3d in_holder = s.holder_pose.inverse() * b.pose;
+          double lo = 1e9, hi = -1e9;
+          for (int i = 0; i < 8; ++i) {
+            const Eigen::Vector3d c((i & 1 ? 1 : -1) * b.half_size.x(), (i & 2 ? 1 : -1) * b.half_size.y(),
+                                    (i & 4 ? 1 : -1) * b.half_size.z());
+            const double yy = (in_holder * c).y();
+            lo = std::min(lo, yy);
+            hi = std::max(hi, yy);
+          }
+          return std::pair<double, double>{lo, hi};
+        }
+      ADD_FAILURE() << "no box " << name;
+      return std::pair<double, double>{0, 0};
+    };
+    const auto back = y_range("holder_back"), ledge = y_range("holder_ledge"), lip = y_range("holder_lip");
+    EXPECT_NEAR(back.first, -0.20, 1e-9);  // base_size_m y 0.40
+    EXPECT_NEAR(ledge.first, -0.20 - ext, 1e-9) << ext;
+    EXPECT_NEAR(lip.first, -0.20 - ext, 1e-9) << ext;
+    EXPECT_NEAR(ledge.second, back.second, 1e-9);
+  }
+}
+
 TEST(Scene, MissingKeyIsNamed) {
   std::string yaml = read_file(kScene);
   const auto pos = yaml.find("  baseline_m: 0.12");
