@@ -122,6 +122,8 @@ std::string cycle_state_name(CycleState s) {
       return "APPROACH_HOLDER";
     case CycleState::kGraspFromHolder:
       return "GRASP_FROM_HOLDER";
+    case CycleState::kBackOutFromHolder:
+      return "BACK_OUT_FROM_HOLDER";
     case CycleState::kLiftFromHolder:
       return "LIFT_FROM_HOLDER";
     case CycleState::kMoveToLowerShelf:
@@ -528,6 +530,9 @@ void LibraryCycle::after_motion() {
     case CycleState::kGraspFromHolder:
       succeed(CycleState::kLiftFromHolder);
       return;
+    case CycleState::kBackOutFromHolder:
+      succeed(CycleState::kMoveToHolderPreGrasp);
+      return;
     case CycleState::kLiftFromHolder:
       if (book_lost_from_plates()) return;
       succeed(CycleState::kMoveToLowerShelf);
@@ -601,7 +606,11 @@ void LibraryCycle::enter(CycleState s) {
       out_.back().force = s_.gripper_force;
       out_.back().speed = s_.gripper_speed;
       const Eigen::Isometry3d here = arm_->end_effector;
-      start_linear({move_along_own_axes(here, Eigen::Vector3d(0, 0, -(g.pre_grasp_distance + g.insertion_depth)))});
+      // Back to where the pre-grasp was (deeper for a front pushed back: pre_grasp_pose).
+      const double gp_z = progress_.gp_grasp.z();
+      const double deeper = std::isfinite(gp_z) ? gp_z - moves_front_z(gp_z, g) : 0.0;
+      start_linear(
+          {move_along_own_axes(here, Eigen::Vector3d(0, 0, -(g.pre_grasp_distance + g.insertion_depth + deeper)))});
       break;
     }
     case CycleState::kPark:
@@ -699,6 +708,7 @@ void LibraryCycle::enter(CycleState s) {
       start_linear({holder_place_pose(holder_frame(), holder_regrasp_height(tcp_height(), g), g)});
       break;
     case CycleState::kRetreatFromHolder:
+    case CycleState::kBackOutFromHolder:
       start_linear({move_along_own_axes(arm_->end_effector, Eigen::Vector3d(0, 0, -g.holder_retreat))});
       break;
     case CycleState::kWaitUser:
@@ -776,8 +786,9 @@ void LibraryCycle::fail(const std::string& reason) {
   }
   step_retries_ += 1;
   message_ = "retry " + std::to_string(step_retries_) + " of " + cycle_state_name(state_) + " after: " + reason;
-  // A missed grasp on the holder: open and come back from the pre-grasp pose.
-  const CycleState again = state_ == CycleState::kGraspFromHolder ? CycleState::kMoveToHolderPreGrasp : state_;
+  // A missed grasp on the holder: straight out (the planner does not plan from between the holder's plates:
+  // "start is in collision", the deployed demo's third book), then come back from the pre-grasp pose.
+  const CycleState again = state_ == CycleState::kGraspFromHolder ? CycleState::kBackOutFromHolder : state_;
   enter(again);
 }
 
@@ -806,6 +817,8 @@ CycleState LibraryCycle::resume_target() const {
       return CycleState::kMoveToHolder;
     case BookPlace::kOnHolder:
       if (in(was, {CycleState::kRetreatFromHolder})) return CycleState::kRetreatFromHolder;
+      if (in(was, {CycleState::kApproachHolder, CycleState::kGraspFromHolder, CycleState::kBackOutFromHolder}))
+        return CycleState::kBackOutFromHolder;
       return CycleState::kParkForUser;
     case BookPlace::kInGripperFromHolder:
       if (in(was, {CycleState::kGraspFromHolder, CycleState::kLiftFromHolder})) return CycleState::kLiftFromHolder;

@@ -206,6 +206,7 @@ enum class CycleState {
   kOpenForHolderGrasp,
   kApproachHolder,
   kGraspFromHolder,
+  kBackOutFromHolder,  ///< after a missed grasp from the holder: straight out, then the pre-grasp again
   kLiftFromHolder,
   kMoveToLowerShelf,
   kPlaceOnLowerShelf,

@@ -73,6 +73,7 @@ class FakeLibrary {
   int next_region_once = 0;                  ///< BwH rank 0 answers NEXT_REGION this many times
   int no_grasp_once = 0;                     ///< BwH answers NO_GRASP this many times
   int missed_grasps = 0;                     ///< the gripper closes on nothing this many times
+  int missed_holder_grasps = 0;              ///< ... on the holder (the book stays there)
   bool servo_silent = false;                 ///< servo never answers (timeouts)
   bool user_answers = true;                  ///< sends "done" in WAIT_USER after 1 s
   int arm_moves_during_planning = 0;         ///< the next N plans: the joints move 0.05 rad before the answer
@@ -276,6 +277,10 @@ class FakeLibrary {
             width = in_gripper->width;
             contact = true;
             ps = Eigen::Vector3d(0.10, in_gripper->right_y - in_gripper->width, -0.10);  // PS.y = GP.y - BW
+          } else if (state == "GRASP_FROM_HOLDER" && on_holder && missed_holder_grasps > 0) {
+            --missed_holder_grasps;
+            width = 0.0;
+            contact = false;
           } else if (state == "GRASP_FROM_HOLDER" && on_holder) {
             holder_grasps.emplace_back(*on_holder, ee);
             in_gripper = on_holder;

@@ -227,6 +227,28 @@ TEST(LibraryCycle, RetriesNextRegionNoGraspMissedGraspAndPlanFailure) {
   EXPECT_EQ(count(w.states, "BACK_OUT"), 1);
 }
 
+TEST(LibraryCycle, AMissedGraspFromTheHolderBacksOutStraightBeforePlanning) {
+  FakeLibrary w(three_books());
+  w.missed_holder_grasps = 1;
+  LibraryCycle cycle(settings(), std::nullopt);
+  w.run(cycle, [&] { return done_or_aborted(cycle); });
+  ASSERT_EQ(cycle.state(), CycleState::kDone) << cycle.status().message;
+  EXPECT_EQ(w.lower.size(), 3u);
+  const auto after = slice(w.states, "GRASP_FROM_HOLDER", 6);
+  EXPECT_EQ(after, (std::vector<std::string>{"GRASP_FROM_HOLDER", "BACK_OUT_FROM_HOLDER", "MOVE_TO_HOLDER_PRE_GRASP",
+                                             "OPEN_FOR_HOLDER_GRASP", "APPROACH_HOLDER", "GRASP_FROM_HOLDER"}));
+  // The back-out is a straight move out along the gripper's -z from where the plates closed on nothing.
+  Eigen::Vector3d closed = Eigen::Vector3d::Zero(), out = Eigen::Vector3d::Zero();
+  for (size_t i = 1; i < w.tcp_path.size(); ++i) {
+    if (w.tcp_path[i].first == "BACK_OUT_FROM_HOLDER" && w.tcp_path[i - 1].first == "GRASP_FROM_HOLDER")
+      closed = w.tcp_path[i - 1].second;
+    if (w.tcp_path[i - 1].first == "BACK_OUT_FROM_HOLDER" && w.tcp_path[i].first != "BACK_OUT_FROM_HOLDER")
+      out = w.tcp_path[i - 1].second;
+  }
+  EXPECT_NEAR((out - closed).norm(), settings().geometry.holder_retreat, 0.01);
+  EXPECT_EQ(cycle.progress().failures, 1);
+}
+
 TEST(LibraryCycle, NoGraspFromTheArbiterStartsANewAttempt) {
   FakeLibrary w(three_books());
   w.no_grasp_once = 1;
