@@ -38,8 +38,6 @@ CycleGeometry CycleGeometry::from_config(const Config& c) {
   g.insertion_depth = c.get_double("grasp.insertion_depth_m", 0.0, 0.2);
   g.pre_grasp_distance = c.get_double("grasp.pre_grasp_distance_m", 0.01, 0.5);
   g.deep_front_z = c.get_double("grasp.deep_front_z_m", -0.2, 0.36);
-  g.miss_probe_step = c.get_double("grasp.miss_probe_step_m", 0.0, 0.2);
-  g.miss_probe_max_z = c.get_double("grasp.miss_probe_max_z_m", -0.2, 0.36);
   g.extract_lift = c.get_double("grasp.extract_lift_m", 0.0, 0.5);
   g.extract_retreat = c.get_double("grasp.extract_retreat_m", 0.0, 1.0);
   g.holder_support_in_marker = vec3(c, "holder.support_origin_in_marker_m");

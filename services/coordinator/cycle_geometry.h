@@ -40,11 +40,6 @@ struct CycleGeometry {
   /// pushed back by an earlier grasp's left plate) gets the pre-grasp and the extraction's end a front at this
   /// depth would get: the plates in front of the planner's books box, the held book's box off the rear board.
   double deep_front_z = 0.035;
-  /// After the plates closed on nothing, the next GP at the same depth (within 5 mm) goes this much deeper per
-  /// miss in a row, up to miss_probe_max_z (grasp Z): the book may stand deeper than P1 or the nominal front said.
-  double miss_probe_step = 0.0;
-  /// See miss_probe_step.
-  double miss_probe_max_z = 0.0;
   double extract_lift = 0.01;       ///< first lift along the gripper x after the grasp
   double extract_retreat = 0.40;    ///< then straight out along the gripper -z
   // holder

@@ -437,13 +437,6 @@ void LibraryCycle::drive_motion(const ArmEvent& e) {
 
 void LibraryCycle::handle_gripper_result(double width, bool contact) {
   if (!contact || width < s_.min_book_width) {
-    if (state_ == CycleState::kCloseGripper) {
-      const double z = progress_.gp_grasp.z();
-      // The depth the arbiter gave (a probe's own deeper Z is not what the next decision will say).
-      const double given = misses_at_z_ > 0 && z > missed_z_ ? missed_z_ : z;
-      misses_at_z_ = std::fabs(given - missed_z_) < 0.005 ? misses_at_z_ + 1 : 1;
-      missed_z_ = given;
-    }
     fail("nothing grasped in " + cycle_state_name(state_) + ": the gripper closed to " + mm(width) +
          (contact ? "" : " without contact"));
     return;
@@ -573,7 +566,6 @@ void LibraryCycle::after_motion() {
         message_ = "book " + std::to_string(b.index) + " on the lower shelf";
       }
       attempt_ = 1;
-      misses_at_z_ = 0;
       succeed(CycleState::kRetreatFromLowerShelf);
       return;
     }
@@ -956,15 +948,6 @@ void LibraryCycle::handle_grasp_decision(const DecisionEvent& d) {
     gp_base_ = d.gp_base;
     progress_.gp_grasp = d.gp_grasp;
     message_ = d.reason;
-    const CycleGeometry& g = s_.geometry;
-    if (misses_at_z_ > 0 && std::fabs(d.gp_grasp.z() - missed_z_) < 0.005 && g.miss_probe_step > 0.0) {
-      // The plates closed on nothing at this depth: the book stands deeper (pushed back by an earlier grasp's
-      // left plate, while P1 was not used or on it).
-      const double dz = std::max(0.0, std::min(misses_at_z_ * g.miss_probe_step, g.miss_probe_max_z - d.gp_grasp.z()));
-      progress_.gp_grasp.z() += dz;
-      gp_base_ = move_along_own_axes(gp_base_, Eigen::Vector3d(0, 0, dz));
-      message_ += "; " + mm(dz) + " deeper: the plates closed on nothing at Z " + mm(missed_z_);
-    }
     succeed(CycleState::kMoveToPreGrasp);
   } else if (d.outcome == "NEXT_REGION") {
     rank_ = d.next_rank;

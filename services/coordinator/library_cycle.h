@@ -28,7 +28,6 @@
 /// progress persisted with where the book is.
 
 #include <cstdint>
-#include <limits>
 #include <optional>
 #include <string>
 #include <vector>
@@ -325,10 +324,6 @@ class LibraryCycle {
   Motion motion_;
   std::vector<CycleRequest> out_;
   int attempt_ = 1;
-  /// Grasp Z (GP) at which the plates last closed on nothing on this book, and how often in a row (the next GP
-  /// at that depth goes grasp.miss_probe_step_m deeper per miss: books pushed back by an earlier grasp).
-  double missed_z_ = std::numeric_limits<double>::quiet_NaN();
-  int misses_at_z_ = 0;
   int step_retries_ = 0;
   bool stripe_done_this_attempt_ = false;
   int64_t stripe_request_ = -1;

@@ -249,32 +249,6 @@ TEST(LibraryCycle, AMissedGraspFromTheHolderBacksOutStraightBeforePlanning) {
   EXPECT_EQ(cycle.progress().failures, 1);
 }
 
-TEST(LibraryCycle, PlatesClosingOnNothingSendTheNextGraspAtThatDepthDeeper) {
-  FakeLibrary w(three_books());
-  w.missed_grasps = 2;  // the first two closes on the first book find nothing
-  const CycleSettings cs = settings();
-  ASSERT_GT(cs.geometry.miss_probe_step, 0.0);
-  LibraryCycle cycle(cs, std::nullopt);
-  w.run(cycle, [&] { return done_or_aborted(cycle); });
-  ASSERT_EQ(cycle.state(), CycleState::kDone) << cycle.status().message;
-  // TCP where the plates closed, and where INSERT started, per attempt on the first book.
-  std::vector<Eigen::Vector3d> closed, insert_from;
-  for (size_t i = 1; i < w.tcp_path.size() && closed.size() < 3; ++i) {
-    if (w.tcp_path[i].first == "INSERT" && w.tcp_path[i - 1].first != "INSERT")
-      insert_from.push_back(w.tcp_path[i].second);
-    if (w.tcp_path[i].first == "CLOSE_GRIPPER" && w.tcp_path[i - 1].first != "CLOSE_GRIPPER")
-      closed.push_back(w.tcp_path[i].second);
-  }
-  ASSERT_EQ(closed.size(), 3u);
-  ASSERT_GE(insert_from.size(), 1u);
-  const Eigen::Vector3d in = (closed[0] - insert_from[0]).normalized();  // the insertion direction
-  const double step = cs.geometry.miss_probe_step;
-  EXPECT_NEAR((closed[1] - closed[0]).dot(in), step, 2e-3);
-  EXPECT_NEAR((closed[2] - closed[0]).dot(in), 2 * step, 2e-3);
-  EXPECT_NEAR((closed[1] - closed[0]).cross(in).norm(), 0.0, 2e-3);  // deeper, not sideways
-  EXPECT_NE(cycle.status().message.find("upper shelf empty"), std::string::npos) << cycle.status().message;
-}
-
 TEST(LibraryCycle, NoGraspFromTheArbiterStartsANewAttempt) {
   FakeLibrary w(three_books());
   w.no_grasp_once = 1;
