@@ -68,6 +68,7 @@ ArbiterSettings ArbiterSettings::from_config(const Config& root) {
   s.tolerances.x = root.get_double("tolerances.x_m", 0.0001, 0.2);
   s.tolerances.max_rank = root.get_int("tolerances.max_rank", 1, 50);
   s.tolerances.p1_over_other_book = root.get<bool>("tolerances.p1_over_other_book");
+  s.tolerances.invalid_p1_depth_range = root.get_double("tolerances.invalid_p1_depth_range_m", 0.0, 0.36);
   s.size_limits.l_max = root.get_double("gripper.l_max_m", 0.005, 0.5);
   s.size_limits.tcp_offset_y =
       root.get_double("gripper.tcp_offset_y_m", -s.size_limits.l_max / 2, s.size_limits.l_max / 2);

@@ -130,6 +130,12 @@ CombinationResult combine(const CombinationInputs& in, const CombinationToleranc
   if (r.p1_valid) {
     gp_z = in.p1->z();
     r.steps.push_back(step("GP.z", 0.0, 0.0, true, "GP.z = P1.z"));
+  } else if (in.p1 && in.p1->allFinite() && in.front_z_fallback && std::isfinite(*in.front_z_fallback) &&
+             std::abs(in.p1->z() - *in.front_z_fallback) <= tol.invalid_p1_depth_range) {
+    gp_z = in.p1->z();
+    r.steps.push_back(step("GP.z", in.p1->z() - *in.front_z_fallback, tol.invalid_p1_depth_range, true,
+                           "P1 invalid in Y: GP.z = P1.z (its front stands as deep as the target's, not the cart "
+                           "model's plane)"));
   } else if (in.front_z_fallback && std::isfinite(*in.front_z_fallback)) {
     gp_z = *in.front_z_fallback;
     r.steps.push_back(step("GP.z", 0.0, 0.0, true, "no valid P1: GP.z from the cart model's book-front plane"));

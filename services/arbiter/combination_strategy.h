@@ -23,6 +23,11 @@ struct CombinationTolerances {
   /// the corner of a taller left neighbour, not of the book P1 (checked against PS) belongs to;
   /// GP is then P1. False applies the paper's rules alone, which accept such a P2 in both axes.
   bool p1_over_other_book = true;
+  /// Not in the paper: a P1 that failed the check against PS still gives GP.z when it lies within this of the
+  /// cart model's front plane (front_z_fallback): its book's fore-edge stands about as deep as the target's
+  /// (flush, or pushed back with it by an earlier grasp's left plate), which the model's constant does not know.
+  /// 0 = the paper (GP.z from the model whenever P1 is invalid).
+  double invalid_p1_depth_range = 0.0;
 };
 
 /// One decision of the strategy, with the numbers it was made on.

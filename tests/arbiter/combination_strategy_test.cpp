@@ -136,6 +136,31 @@ TEST(CombinationStrategy, TheLeftNeighbourRuleCanBeSwitchedOffForThePapersRules)
   EXPECT_NEAR(ours.steps[ours.steps.size() - 2].value, -0.02, 1e-12);
 }
 
+TEST(CombinationStrategy, AnInvalidP1NearTheModelsFrontGivesTheDepth) {
+  CombinationTolerances tol = kTol;
+  tol.invalid_p1_depth_range = 0.15;
+  CombinationInputs in;
+  in.ps = kPs;
+  in.p2 = V(0.09, 0.095, 0.45);
+  in.front_z_fallback = 0.42;
+  // P1 2 cm from PS (invalid in Y), 8 cm deeper than the model's plane: GP.z = P1.z; X and Y still from P2.
+  in.p1 = V(0.10, 0.080, 0.50);
+  CombinationResult r = combine(in, tol);
+  ASSERT_EQ(outcome_name(r.outcome), outcome_name(GraspOutcome::kGrasp));
+  EXPECT_FALSE(r.p1_valid);
+  EXPECT_TRUE(r.gp.isApprox(V(0.09, 0.095, 0.50), 1e-12)) << r.gp.transpose();
+  EXPECT_NE(r.steps.back().decision.find("GP.z = P1.z"), std::string::npos) << r.steps.back().decision;
+  // 18 cm off the model's plane (beyond 0.15): not a book front the target can stand at, the model's plane.
+  in.p1 = V(0.10, 0.080, 0.60);
+  r = combine(in, tol);
+  EXPECT_TRUE(r.gp.isApprox(V(0.09, 0.095, 0.42), 1e-12)) << r.gp.transpose();
+  EXPECT_NE(r.steps.back().decision.find("cart model"), std::string::npos) << r.steps.back().decision;
+  // The paper (range 0): the model's plane whatever P1 says.
+  in.p1 = V(0.10, 0.080, 0.50);
+  r = combine(in, kTol);
+  EXPECT_TRUE(r.gp.isApprox(V(0.09, 0.095, 0.42), 1e-12)) << r.gp.transpose();
+}
+
 TEST(CombinationStrategy, P1ValidityBoundaryAndTrace) {
   CombinationInputs in;
   in.ps = kPs;

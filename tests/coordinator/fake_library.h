@@ -73,6 +73,7 @@ class FakeLibrary {
   int next_region_once = 0;                  ///< BwH rank 0 answers NEXT_REGION this many times
   int no_grasp_once = 0;                     ///< BwH answers NO_GRASP this many times
   int missed_grasps = 0;                     ///< the gripper closes on nothing this many times
+  std::optional<double> invalid_p1_z;        ///< P1 checks answer P1_INVALID with a P1 2 cm off PS at this Z
   int missed_holder_grasps = 0;              ///< ... on the holder (the book stays there)
   bool servo_silent = false;                 ///< servo never answers (timeouts)
   bool user_answers = true;                  ///< sends "done" in WAIT_USER after 1 s
@@ -191,6 +192,10 @@ class FakeLibrary {
     if (ps) d.ps_grasp = *ps;
     if (!ps) {
       d.outcome = "NEED_PS";
+    } else if (!upper.empty() && invalid_p1_z) {
+      d.outcome = "P1_INVALID";
+      d.gp_grasp = *ps;
+      d.p1_grasp = Eigen::Vector3d(upper.front().height, ps->y() + 0.02, *invalid_p1_z);
     } else if (!upper.empty()) {
       d.outcome = "P1_VALID";
       d.gp_grasp = Eigen::Vector3d(upper.front().height, upper.front().right_y, kP1FrontZ);

@@ -249,6 +249,26 @@ TEST(LibraryCycle, AMissedGraspFromTheHolderBacksOutStraightBeforePlanning) {
   EXPECT_EQ(cycle.progress().failures, 1);
 }
 
+TEST(LibraryCycle, AnInvalidP1NearTheModelsFrontSetsTheCornerServosDepth) {
+  // coordinator.yaml: book_front_z_m 0.01, invalid_p1_depth_range_m 0.15, bwh_start_z_m -0.10.
+  const CycleSettings cs = settings();
+  ASSERT_NEAR(cs.geometry.book_front_z, 0.01, 1e-12);
+  ASSERT_NEAR(cs.geometry.invalid_p1_depth_range, 0.15, 1e-12);
+  for (const auto& [p1_z, standoff] : {std::pair{0.09, 0.19}, std::pair{0.20, 0.11}}) {
+    FakeLibrary w(three_books());
+    w.invalid_p1_z = p1_z;  // 0.09: 8 cm behind the model's plane (pushed back); 0.20: 19 cm, beyond the range
+    LibraryCycle cycle(cs, std::nullopt);
+    w.run(cycle, [&] { return done_or_aborted(cycle); });
+    int corner_requests = 0;
+    for (const auto& q : w.requests)
+      if (q.kind == CycleRequest::Kind::kServo && q.servo_mode == 1) {
+        ++corner_requests;
+        EXPECT_NEAR(q.fixed_depth, standoff, 1e-12) << "P1.z " << p1_z;
+      }
+    EXPECT_GE(corner_requests, 1) << "P1.z " << p1_z;
+  }
+}
+
 TEST(LibraryCycle, NoGraspFromTheArbiterStartsANewAttempt) {
   FakeLibrary w(three_books());
   w.no_grasp_once = 1;

@@ -112,9 +112,11 @@ namespace bookgrasp {
 namespace {
 
 // logs/samples/arbiter_seed5.lcm: the arbiter's inputs and outputs from the composed full-cycle harness
-// on seed 5 (bookgrasp_eval_full --scenes 1 --seed 5 --scene config/scenes/default.yaml --books 2 --stereo-hz 2
-// --log: two books through the whole cycle), filtered to the arbiter's channels (BOOK_CORNER_STEREO,
-// SERVO_STATUS, SERVO_REQUEST, MARKERS, ARM_STATE, DETECTOR_SWITCH, GRASP_POINT); re-recorded 2026-12-02 after the TCP offset (S_max 45 mm).
+// on seed 5 (bookgrasp_eval_full --scenes 1 --seed 5 --scene config/scenes/default.yaml --books 3 --stereo-hz 2
+// --log: two books through the whole cycle, the third ABORTED when the corner servo stopped at a joint limit; 16
+// decisions), filtered to the arbiter's channels (BOOK_CORNER_STEREO, SERVO_STATUS, SERVO_REQUEST, MARKERS,
+// ARM_STATE, DETECTOR_SWITCH, GRASP_POINT); re-recorded 2026-12-03 for the invalid P1's depth
+// (tolerances.invalid_p1_depth_range_m) and the holder's longer ledge.
 DiffReport replay_arbiter(const std::string& config_path) {
   const auto log = read_lcm_log(std::string(BOOKGRASP_SOURCE_DIR) + "/logs/samples/arbiter_seed5.lcm");
   std::vector<std::unique_ptr<Component>> cs;
