@@ -132,9 +132,12 @@ double moves_front_z(double gp_z, const CycleGeometry& g) {
   return std::min(gp_z, g.deep_front_z);
 }
 
+double pre_grasp_back_off(double gp_z, const CycleGeometry& g) {
+  return g.pre_grasp_distance + (std::isfinite(gp_z) ? gp_z - moves_front_z(gp_z, g) : 0.0);
+}
+
 Eigen::Isometry3d pre_grasp_pose(const Eigen::Isometry3d& gp, double gp_z, const CycleGeometry& g) {
-  const double back = g.pre_grasp_distance + (gp_z - moves_front_z(gp_z, g));
-  return move_along_own_axes(gp, Eigen::Vector3d(g.grasp_offset_x, g.grasp_offset_y, -back));
+  return move_along_own_axes(gp, Eigen::Vector3d(g.grasp_offset_x, g.grasp_offset_y, -pre_grasp_back_off(gp_z, g)));
 }
 
 double tcp_height_on_book(const Eigen::Vector3d& gp_grasp, const CycleGeometry& g) {

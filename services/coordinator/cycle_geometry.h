@@ -86,6 +86,10 @@ Eigen::Isometry3d grasp_pose(const Eigen::Isometry3d& gp_base, const CycleGeomet
 /// GP's grasp Z as the moves around the grasp see it: min(gp_z, deep_front_z).
 double moves_front_z(double gp_z, const CycleGeometry& g);
 
+/// How far in front of GP (along -Z) the pre-grasp lies: pre_grasp_distance, plus how much deeper than
+/// deep_front_z GP lies (`gp_z`: GP's grasp Z; not finite = no extra).
+double pre_grasp_back_off(double gp_z, const CycleGeometry& g);
+
 /// Pre-grasp pose: the grasp pose moved back along its z to `pre_grasp_distance` in front of GP, or in front
 /// of grasp Z `deep_front_z` when GP lies deeper (`gp_z`: GP's grasp Z, into the shelf).
 Eigen::Isometry3d pre_grasp_pose(const Eigen::Isometry3d& gp_base, double gp_z, const CycleGeometry& g);

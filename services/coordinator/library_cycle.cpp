@@ -606,11 +606,9 @@ void LibraryCycle::enter(CycleState s) {
       out_.back().force = s_.gripper_force;
       out_.back().speed = s_.gripper_speed;
       const Eigen::Isometry3d here = arm_->end_effector;
-      // Back to where the pre-grasp was (deeper for a front pushed back: pre_grasp_pose).
-      const double gp_z = progress_.gp_grasp.z();
-      const double deeper = std::isfinite(gp_z) ? gp_z - moves_front_z(gp_z, g) : 0.0;
-      start_linear(
-          {move_along_own_axes(here, Eigen::Vector3d(0, 0, -(g.pre_grasp_distance + g.insertion_depth + deeper)))});
+      // Back to where the pre-grasp was (deeper for a front pushed back).
+      const double back = pre_grasp_back_off(progress_.gp_grasp.z(), g) + g.insertion_depth;
+      start_linear({move_along_own_axes(here, Eigen::Vector3d(0, 0, -back))});
       break;
     }
     case CycleState::kPark:

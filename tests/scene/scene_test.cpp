@@ -203,14 +203,12 @@ TEST(Scene, TheHoldersLedgeReachesBeyondTheBackPlatesRightEnd) {
     const auto y_range = [&](const std::string& name) {
       for (const StaticBox& b : s.boxes)
         if (b.name == name) {
-          const Eigen::Isometry3d in_holder = s.holder_pose.inverse() * b.pose;
+          // The box's corners in the holder frame (book_corners: x = depth, y = width, z = height).
+          const Eigen::Vector3d size = 2 * b.half_size;
           double lo = 1e9, hi = -1e9;
-          for (int i = 0; i < 8; ++i) {
-            const Eigen::Vector3d c((i & 1 ? 1 : -1) * b.half_size.x(), (i & 2 ? 1 : -1) * b.half_size.y(),
-                                    (i & 4 ? 1 : -1) * b.half_size.z());
-            const double yy = (in_holder * c).y();
-            lo = std::min(lo, yy);
-            hi = std::max(hi, yy);
+          for (const Eigen::Vector3d& c : book_corners(s.holder_pose.inverse() * b.pose, size.y(), size.z(), size.x())) {
+            lo = std::min(lo, c.y());
+            hi = std::max(hi, c.y());
           }
           return std::pair<double, double>{lo, hi};
         }
