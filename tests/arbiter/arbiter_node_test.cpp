@@ -460,5 +460,18 @@ TEST(ArbiterConfig, ShippedConfigReadsCompletelyAndBadValuesNameTheKey) {
   }
 }
 
+TEST(ArbiterConfig, ABadInvalidP1DepthRangeNamesTheKey) {
+  std::string text = arbiter_config().dump();
+  const auto pos = text.find("invalid_p1_depth_range_m: 0.15");
+  ASSERT_NE(pos, std::string::npos);
+  text.replace(pos, 30, "invalid_p1_depth_range_m: -0.1");
+  try {
+    ArbiterNode bad(Config::from_string(text, "arbiter.yaml"));
+    FAIL() << "a negative range must be refused";
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("tolerances.invalid_p1_depth_range_m"), std::string::npos) << e.what();
+  }
+}
+
 }  // namespace
 }  // namespace bookgrasp

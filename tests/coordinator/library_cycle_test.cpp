@@ -8,8 +8,11 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <fstream>
 #include <functional>
+#include <sstream>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "common/config.h"
@@ -266,6 +269,28 @@ TEST(LibraryCycle, AnInvalidP1NearTheModelsFrontSetsTheCornerServosDepth) {
         EXPECT_NEAR(q.fixed_depth, standoff, 1e-12) << "P1.z " << p1_z;
       }
     EXPECT_GE(corner_requests, 1) << "P1.z " << p1_z;
+  }
+}
+
+TEST(LibraryCycle, BadDepthKeysNameTheKey) {
+  std::ifstream f(std::string(BOOKGRASP_SOURCE_DIR) + "/config/services/coordinator.yaml");
+  std::stringstream ss;
+  ss << f.rdbuf();
+  const std::string shipped = ss.str();
+  for (const auto& [key, line, bad] :
+       {std::tuple<std::string, std::string, std::string>{"grasp.deep_front_z_m", "deep_front_z_m: 0.035",
+                                                          "deep_front_z_m: 0.9"},
+        {"servo.invalid_p1_depth_range_m", "invalid_p1_depth_range_m: 0.15", "invalid_p1_depth_range_m: -1"}}) {
+    std::string text = shipped;
+    const auto pos = text.find(line);
+    ASSERT_NE(pos, std::string::npos) << line;
+    text.replace(pos, line.size(), bad);
+    try {
+      CycleSettings::from_config(bookgrasp::Config::from_string(text, "coordinator.yaml"));
+      ADD_FAILURE() << "accepted " << bad;
+    } catch (const bookgrasp::ConfigError& e) {
+      EXPECT_NE(std::string(e.what()).find(key), std::string::npos) << e.what();
+    }
   }
 }
 

@@ -223,6 +223,19 @@ TEST(Scene, TheHoldersLedgeReachesBeyondTheBackPlatesRightEnd) {
   }
 }
 
+TEST(Scene, ANegativeLedgeExtensionNamesTheKey) {
+  std::string yaml = read_file(kScene);
+  const auto pos = yaml.find("ledge_extension_right_m: 0.10");
+  ASSERT_NE(pos, std::string::npos);
+  yaml.replace(pos, 29, "ledge_extension_right_m: -0.1");
+  try {
+    generate_scene(Config::from_string(yaml, "test.yaml"), 1, std::string(BOOKGRASP_SOURCE_DIR) + "/config/scenes");
+    FAIL() << "no error for a negative ledge extension";
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("holder.ledge_extension_right_m"), std::string::npos) << e.what();
+  }
+}
+
 TEST(Scene, MissingKeyIsNamed) {
   std::string yaml = read_file(kScene);
   const auto pos = yaml.find("  baseline_m: 0.12");
