@@ -69,6 +69,21 @@ ArbiterSettings ArbiterSettings::from_config(const Config& root) {
   s.tolerances.max_rank = root.get_int("tolerances.max_rank", 1, 50);
   s.tolerances.p1_over_other_book = root.get<bool>("tolerances.p1_over_other_book");
   s.tolerances.invalid_p1_depth_range = root.get_double("tolerances.invalid_p1_depth_range_m", 0.0, 0.36);
+  s.use_stereo_front = root.get<bool>("stereo_front.enabled");
+  const std::vector<double> band = root.get_vector("stereo_front.probe_left_of_ps_m", 2);
+  if (!(band[0] >= 0 && band[0] < band[1] && band[1] <= 0.1))
+    throw ConfigError(root.source() + ": " + root.path_of("stereo_front.probe_left_of_ps_m") +
+                      " must be [near, far] with 0 <= near < far <= 0.1 (metres left of PS)");
+  s.stereo_front.near_left = band[0];
+  s.stereo_front.far_left = band[1];
+  s.stereo_front.max_tilt = root.get_double("stereo_front.max_tilt_deg", 0.0, 89.0) * M_PI / 180.0;
+  s.stereo_front.min_top = root.get_double("stereo_front.min_top_m", -0.1, 0.5);
+  const std::vector<double> zr = root.get_vector("stereo_front.depth_range_m", 2);
+  if (!(std::isfinite(zr[0]) && std::isfinite(zr[1]) && zr[0] < zr[1]))
+    throw ConfigError(root.source() + ": " + root.path_of("stereo_front.depth_range_m") +
+                      " must be [min, max] with min < max (grasp-frame Z, metres)");
+  s.stereo_front.min_z = zr[0];
+  s.stereo_front.max_z = zr[1];
   s.size_limits.l_max = root.get_double("gripper.l_max_m", 0.005, 0.5);
   s.size_limits.tcp_offset_y =
       root.get_double("gripper.tcp_offset_y_m", -s.size_limits.l_max / 2, s.size_limits.l_max / 2);
@@ -109,6 +124,7 @@ Eigen::Vector3d ArbiterNode::to_base(const Eigen::Vector3d& p_grasp) const { ret
 void ArbiterNode::open_attempt() {
   frozen_ = false;
   frozen_p1_.reset();
+  frozen_regions_.clear();
 }
 
 void ArbiterNode::on_markers(const marker_detections_t& msg) {
@@ -165,6 +181,7 @@ void ArbiterNode::on_book_corner(const book_corner_stereo_t& msg) {
     return;
   }
   have_p1_msg_ = true;
+  latest_regions_ = msg.regions;
   if (msg.found)
     latest_p1_ = Eigen::Vector3d(msg.p1_base[0], msg.p1_base[1], msg.p1_base[2]);
   else
@@ -189,6 +206,7 @@ void ArbiterNode::on_servo_request(const servo_request_t& msg) {
   if (!frozen_) {
     frozen_ = true;
     frozen_p1_ = latest_p1_;
+    frozen_regions_ = latest_regions_;
   }
   if (msg.mode == servo_request_t::BOOK_CORNER) {
     rank_of_request_[msg.request_id] = msg.rank_from_right;
@@ -271,9 +289,17 @@ void ArbiterNode::publish_p1_check(int64_t utime, int64_t request_id) {
   CombinationInputs in;
   in.p1 = p1;
   in.ps = to_grasp(*ps_);
+  in.front_z_fallback = s_.book_front_z;
+  in.stereo_front_z = stereo_front_z(in.ps);
   put(m.ps_grasp, in.ps);
   const CombinationResult r = validate_p1(in, s_.tolerances);
   for (const ValidationStep& st : r.steps) m.steps.push_back(to_msg(st, utime));
+  if (!r.p1_valid) {  // the depth the corner servo assumes (GP.z will take the same), as gp_grasp's Z
+    ValidationStep z_step;
+    front_depth_without_p1(in, s_.tolerances, &z_step);
+    z_step.rule = "front depth for BwH";
+    m.steps.push_back(to_msg(z_step, utime));
+  }
   m.p1_used = r.p1_valid;
   put(m.gp_grasp, r.bwh_start);
   Eigen::Isometry3d start = *frame_;
@@ -281,6 +307,7 @@ void ArbiterNode::publish_p1_check(int64_t utime, int64_t request_id) {
   m.gp_base = isometry_to_pose(start, "base", "gripper", utime);
   m.reason = std::string(r.p1_valid ? "P1_VALID: " : "P1_INVALID: ") +
              (r.steps.empty() ? std::string("") : r.steps.back().decision);
+  if (!r.p1_valid) m.reason += "; servo front depth " + mm(r.bwh_start.z());
   finish(&m, follow_, switch_note_);
   publish(s_.channels.grasp_point, m);
 }
@@ -305,6 +332,7 @@ void ArbiterNode::decide(const servo_status_t& msg) {
   const auto rank_it = rank_of_request_.find(msg.request_id);
   in.p2_rank = rank_it == rank_of_request_.end() ? 0 : rank_it->second;
   in.front_z_fallback = s_.book_front_z;
+  in.stereo_front_z = stereo_front_z(in.ps);
   double slope = 0;
   if (converged) {
     const Eigen::Isometry3d p2 = pose_to_isometry(msg.converged_pose);
@@ -360,6 +388,33 @@ void ArbiterNode::decide(const servo_status_t& msg) {
   for (const ValidationStep& st : r.steps) m.steps.push_back(to_msg(st, msg.utime));
   finish(&m, follow_, switch_note_);
   publish(s_.channels.grasp_point, m);
+}
+
+std::optional<double> ArbiterNode::stereo_front_z(const Eigen::Vector3d& ps_grasp) const {
+  if (!s_.use_stereo_front || !frame_) return std::nullopt;
+  const std::vector<plane_region_t>& regions = frozen_ ? frozen_regions_ : latest_regions_;
+  const Eigen::Matrix3d to_grasp_axes = frame_->linear().transpose();
+  std::vector<FrontPlane> planes;
+  planes.reserve(regions.size());
+  for (const plane_region_t& g : regions) {
+    FrontPlane p;
+    const Eigen::Vector3d n(g.normal_base[0], g.normal_base[1], g.normal_base[2]);
+    p.normal = to_grasp_axes * n;
+    p.offset = g.offset_m - n.dot(frame_->translation());  // n . (R p_g + t) = offset
+    const Eigen::Vector3d lo(g.extent_min_base[0], g.extent_min_base[1], g.extent_min_base[2]);
+    const Eigen::Vector3d hi(g.extent_max_base[0], g.extent_max_base[1], g.extent_max_base[2]);
+    p.min = Eigen::Vector3d::Constant(INFINITY);
+    p.max = Eigen::Vector3d::Constant(-INFINITY);
+    for (int c = 0; c < 8; ++c) {  // the base box's corners in the grasp frame, then their box
+      const Eigen::Vector3d corner((c & 1) ? hi.x() : lo.x(), (c & 2) ? hi.y() : lo.y(), (c & 4) ? hi.z() : lo.z());
+      const Eigen::Vector3d q = to_grasp(corner);
+      p.min = p.min.cwiseMin(q);
+      p.max = p.max.cwiseMax(q);
+    }
+    p.pixels = g.pixel_count;
+    planes.push_back(p);
+  }
+  return front_depth_left_of(planes, ps_grasp, s_.stereo_front);
 }
 
 void ArbiterNode::on_arm_state(const arm_state_t& msg) {

@@ -47,6 +47,7 @@
 #include "common/component.h"
 #include "common/config.h"
 #include "services/arbiter/combination_strategy.h"
+#include "services/arbiter/stereo_front_depth.h"
 
 namespace bookgrasp {
 
@@ -59,6 +60,10 @@ struct ArbiterSettings {
   std::string follow_logical_channel;   ///< DETECTOR_SWITCH.logical_channel this node answers to
   std::string follow_implementation;    ///< initial implementation of BOOK_CORNER_STEREO to follow
   CombinationTolerances tolerances;     ///< the paper's tolerances
+  /// Not in the paper: without a valid P1, the front depth from BwS's regions just left of PS (stereo_front.*);
+  /// off = no stereo depth (the invalid P1's depth or the model's plane, as before).
+  bool use_stereo_front = true;
+  StereoFrontProbe stereo_front;        ///< which region is the target's front
   BookSizeLimits size_limits;           ///< L_max of the gripper
   std::string cart_marker_role;         ///< MARKERS role of the cart marker
   /// Cart (grasp-frame) origin from the marker centre, in grasp axes (X up, Y right, Z into the shelf), m.
@@ -106,6 +111,8 @@ class ArbiterNode : public Component {
   grasp_point_t base_message(int64_t utime, int64_t request_id) const;
   Eigen::Vector3d to_grasp(const Eigen::Vector3d& p_base) const;
   Eigen::Vector3d to_base(const Eigen::Vector3d& p_grasp) const;
+  /// The attempt's stereo front depth left of `ps_grasp` (stereo_front_depth.h), if enabled and found.
+  std::optional<double> stereo_front_z(const Eigen::Vector3d& ps_grasp) const;
 
   ArbiterSettings s_;
   std::string follow_;
@@ -114,6 +121,8 @@ class ArbiterNode : public Component {
   std::optional<Eigen::Vector3d> latest_p1_;   ///< base; empty when BwS found nothing
   bool have_p1_msg_ = false;                   ///< a followed BOOK_CORNER_STEREO arrived
   std::optional<Eigen::Vector3d> frozen_p1_;   ///< P1 of the attempt (base)
+  std::vector<plane_region_t> latest_regions_;  ///< the followed BwS frame's regions (base)
+  std::vector<plane_region_t> frozen_regions_;  ///< ... of the attempt
   bool frozen_ = false;
   std::optional<Eigen::Vector3d> ps_;          ///< base
   std::map<int64_t, int> rank_of_request_;     ///< BOOK_CORNER request id -> rank

@@ -33,10 +33,36 @@ std::string outcome_name(GraspOutcome o) {
   return "?";
 }
 
+std::optional<double> front_depth_without_p1(const CombinationInputs& in, const CombinationTolerances& tol,
+                                             ValidationStep* out) {
+  const bool model = in.front_z_fallback && std::isfinite(*in.front_z_fallback);
+  auto near_model = [&](double z) {
+    return model && std::isfinite(z) && std::abs(z - *in.front_z_fallback) <= tol.invalid_p1_depth_range;
+  };
+  if (in.stereo_front_z && near_model(*in.stereo_front_z)) {
+    *out = step("GP.z", *in.stereo_front_z - *in.front_z_fallback, tol.invalid_p1_depth_range, true,
+                "no valid P1: GP.z from the stereo plane just left of PS (the target's front, pushed back or not)");
+    return *in.stereo_front_z;
+  }
+  if (in.p1 && in.p1->allFinite() && near_model(in.p1->z())) {
+    *out = step("GP.z", in.p1->z() - *in.front_z_fallback, tol.invalid_p1_depth_range, true,
+                "P1 invalid in Y: GP.z = P1.z (its front stands as deep as the target's, not the cart model's plane)");
+    return in.p1->z();
+  }
+  if (model) {
+    *out = step("GP.z", 0.0, 0.0, true, "no valid P1: GP.z from the cart model's book-front plane");
+    return *in.front_z_fallback;
+  }
+  *out = step("GP.z", NAN, NAN, false, "no valid P1 and no book-front plane from the cart model: GP.z unknown");
+  return std::nullopt;
+}
+
 CombinationResult validate_p1(const CombinationInputs& in, const CombinationTolerances& tol) {
   CombinationResult r;
   r.bwh_start = in.ps;
   if (!in.ps.allFinite()) return fail(r, "inputs", "PS is not finite: no reference for the right-most book");
+  ValidationStep z_step;
+  r.bwh_start.z() = front_depth_without_p1(in, tol, &z_step).value_or(NAN);  // replaced by P1.z when P1 is valid
   if (!in.p1) {
     r.steps.push_back(step("P1.y vs PS.y", NAN, tol.p1_ps_y, false, "no P1 from BwS: ignore BwS, BwH starts from PS"));
     return r;
@@ -130,17 +156,12 @@ CombinationResult combine(const CombinationInputs& in, const CombinationToleranc
   if (r.p1_valid) {
     gp_z = in.p1->z();
     r.steps.push_back(step("GP.z", 0.0, 0.0, true, "GP.z = P1.z"));
-  } else if (in.p1 && in.p1->allFinite() && in.front_z_fallback && std::isfinite(*in.front_z_fallback) &&
-             std::abs(in.p1->z() - *in.front_z_fallback) <= tol.invalid_p1_depth_range) {
-    gp_z = in.p1->z();
-    r.steps.push_back(step("GP.z", in.p1->z() - *in.front_z_fallback, tol.invalid_p1_depth_range, true,
-                           "P1 invalid in Y: GP.z = P1.z (its front stands as deep as the target's, not the cart "
-                           "model's plane)"));
-  } else if (in.front_z_fallback && std::isfinite(*in.front_z_fallback)) {
-    gp_z = *in.front_z_fallback;
-    r.steps.push_back(step("GP.z", 0.0, 0.0, true, "no valid P1: GP.z from the cart model's book-front plane"));
   } else {
-    return fail(r, "GP.z", "no valid P1 and no book-front plane from the cart model: GP.z unknown");
+    ValidationStep z_step;
+    const std::optional<double> z = front_depth_without_p1(in, tol, &z_step);
+    if (!z) return fail(r, z_step.rule, z_step.decision);
+    gp_z = *z;
+    r.steps.push_back(z_step);
   }
 
   r.gp = Eigen::Vector3d(gp_x, gp_y, gp_z);

@@ -57,6 +57,10 @@ struct CombinationInputs {
   /// GP.z from P1; without P1 the node supplies the front plane from the cart
   /// model (marker + geometry). Required when p1 is missing or invalid.
   std::optional<double> front_z_fallback;
+  /// Not in the paper: the depth of a stereo plane just left of PS (stereo_front_depth.h), the pushed target's
+  /// front when P1 lies on another book. Used without a valid P1 when within invalid_p1_depth_range of
+  /// front_z_fallback.
+  std::optional<double> stereo_front_z;
 };
 
 /// Result: GP (grasp frame) and every step.
@@ -65,10 +69,17 @@ struct CombinationResult {
   Eigen::Vector3d gp = Eigen::Vector3d::Zero();  ///< GP = (P2.x, P2.y, P1.z) after validation
   bool p1_valid = false;                         ///< P1 passed the PS check and was used
   int next_rank = 0;                             ///< for kNextRegion: the rank to ask BwH for
-  /// Where BwH should start servoing: P1 if valid, else PS (Section 3.1).
+  /// Where BwH should start servoing: P1 if valid, else PS (Section 3.1) in X and Y. Its Z is the depth of the
+  /// book's front the servo should assume: P1.z if valid, else front_depth_without_p1 (NaN when unknown).
   Eigen::Vector3d bwh_start = Eigen::Vector3d::Zero();
   std::vector<ValidationStep> steps;
 };
+
+/// The target front's depth (Z) without a valid P1, and the step saying where it came from: the stereo plane
+/// left of PS, else the invalid P1's own depth (each only within tol.invalid_p1_depth_range of the model's
+/// plane), else the model's plane (front_z_fallback). Empty (with a failed step) when none is known.
+std::optional<double> front_depth_without_p1(const CombinationInputs& in, const CombinationTolerances& tol,
+                                             ValidationStep* step);
 
 /// Step 1 only (Section 3.1): is P1 valid against PS, and where BwH starts.
 /// Used before servoing; combine() repeats it so its trace is complete.

@@ -33,7 +33,6 @@ CycleGeometry CycleGeometry::from_config(const Config& c) {
   g.bwh_start_z = c.get_double("servo.bwh_start_z_m", -1.0, 0.0);
   g.bwh_start_offset_x = c.get_double("servo.bwh_start_offset_x_m", -0.3, 0.3);
   g.book_front_z = c.get_double("servo.book_front_z_m", -0.2, 0.3);
-  g.invalid_p1_depth_range = c.get_double("servo.invalid_p1_depth_range_m", 0.0, 0.36);
   g.grasp_offset_x = c.get_double("grasp.offset_x_m", -0.1, 0.1);
   g.grasp_offset_y = c.get_double("grasp.offset_y_m", -0.1, 0.1);
   g.insertion_depth = c.get_double("grasp.insertion_depth_m", 0.0, 0.2);

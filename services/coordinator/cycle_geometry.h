@@ -30,10 +30,7 @@ struct CycleGeometry {
   double stripe_fixed_depth = 0.2;  ///< distance kept to the rear board during the stripe servo
   double bwh_start_z = -0.15;       ///< fixed Z in front of the cart where BwH starts
   double bwh_start_offset_x = 0.0;  ///< added to the start point's X
-  double book_front_z = 0.01;       ///< grasp Z of the books' fronts when BwS gave no valid P1 (arbiter's alike)
-  /// A P1 invalid in Y within this of book_front_z gives the corner servo its front depth instead (arbiter.yaml
-  /// tolerances.invalid_p1_depth_range_m alike); 0 = book_front_z whenever P1 is invalid.
-  double invalid_p1_depth_range = 0.0;
+  double book_front_z = 0.01;       ///< grasp Z of the books' fronts when the arbiter's P1 check gave no depth
   // grasp
   double grasp_offset_x = 0.0;      ///< TCP below (-) / above (+) GP along X
   double grasp_offset_y = 0.0;      ///< TCP right (+) of GP along Y

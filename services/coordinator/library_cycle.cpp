@@ -917,10 +917,10 @@ void LibraryCycle::handle_p1_check(const DecisionEvent& d) {
 void LibraryCycle::start_bwh_from(const DecisionEvent& d) {
   bwh_start_ = d.gp_grasp;
   const CycleGeometry& g = s_.geometry;
-  // An invalid P1's front depth is the target's too (flush, or pushed back with it): the corner servo's image
-  // target and so P2 depend on it (arbiter.yaml tolerances.invalid_p1_depth_range_m takes the same P1.z for GP.z).
-  const bool p1_depth = d.p1_present && std::abs(d.p1_grasp.z() - g.book_front_z) <= g.invalid_p1_depth_range;
-  bwh_front_z_ = d.outcome == "P1_VALID" ? d.gp_grasp.z() : p1_depth ? d.p1_grasp.z() : g.book_front_z;
+  // The corner servo's image target and so P2 depend on the front's depth. The arbiter's P1 check gives it as
+  // gp_grasp's Z: P1.z when valid, else the depth GP.z will take (a stereo plane left of PS, the invalid P1's,
+  // or the model's); book_front_z only when it gave none.
+  bwh_front_z_ = std::isfinite(d.gp_grasp.z()) ? d.gp_grasp.z() : g.book_front_z;
   rank_ = 0;
   message_ = d.reason;
   succeed(CycleState::kMoveToBwhStart);

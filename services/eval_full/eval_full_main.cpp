@@ -20,6 +20,16 @@
 
 namespace {
 
+/// "A,B,C" -> {A, B, C}; throws when it names no channel.
+std::vector<std::string> channel_list(const std::string& text) {
+  std::vector<std::string> out;
+  std::stringstream list(text);
+  for (std::string c; std::getline(list, c, ',');)
+    if (!c.empty()) out.push_back(c);
+  if (out.empty()) throw std::invalid_argument("--log-channels needs at least one channel name");
+  return out;
+}
+
 void usage(std::ostream& os) {
   os << "usage: bookgrasp_eval_full --scenes N --seed S --out DIR [options]\n"
         "  N seeded scenes (seeds S, S+1, ..., S+N-1) through the whole library cycle in one process.\n"
@@ -30,11 +40,13 @@ void usage(std::ostream& os) {
         "  --stereo-hz R      stereo camera frame rate (default: stereo_camera.yaml)\n"
         "  --hand-hz R        hand camera frame rate (default: hand_camera.yaml)\n"
         "  --log              record each scene's bus (no images) to DIR/logs/seed_<S>.lcmlog\n"
+        "  --log-channels A,B,...  with --log: record only these channels (e.g. the arbiter's, for a replay sample)\n"
         "  --snapshots        PNGs of the hand/stereo images (with what was detected, and the hand image raw) at\n"
         "                     every state change in DIR/snapshots/seed_<S>/\n"
         "  --snapshot-period-s P  with --snapshots: also a hand image every P s while a servo runs\n"
         "  --verbose          print the TASK_STATUS / GRASP_POINT trace\n"
-        "  --set S:KEY=VALUE  override a configuration value of service S (e.g. marker_detector:apriltag.quad_decimate=1)\n"
+        "  --set S:KEY=VALUE  override a configuration value of service S (e.g. "
+        "marker_detector:apriltag.quad_decimate=1)\n"
         "  --source-dir DIR   project tree (default: the one this tool was built from)\n"
         "Re-run one failed scene alone: --scenes 1 --seed <its seed>.\n";
 }
@@ -60,7 +72,7 @@ int main(int argc, char** argv) {
   double budget = -1, done_after = 1.0, stereo_hz = 0, hand_hz = 0;
   std::string out, scene_file, source_dir = BOOKGRASP_SOURCE_DIR;
   bool log = false, snapshots = false, verbose = false;
-  std::vector<std::string> overrides;
+  std::vector<std::string> overrides, log_channels;
   std::ostringstream cmd;
   cmd << "bookgrasp_eval_full";
   for (int i = 1; i < argc; ++i) cmd << " " << argv[i];
@@ -86,6 +98,8 @@ int main(int argc, char** argv) {
       else if (a == "--source-dir") source_dir = value();
       else if (a == "--set") overrides.push_back(value());
       else if (a == "--log") log = true;
+      else if (a == "--log-channels")
+        log_channels = channel_list(value());
       else if (a == "--snapshots") snapshots = true;
       else if (a == "--snapshot-period-s") snapshot_period = std::stod(value());
       else if (a == "--verbose") verbose = true;
@@ -124,6 +138,7 @@ int main(int argc, char** argv) {
     o.overrides = overrides;
     o.snapshot_period_s = snapshot_period;
     if (log) o.log_file = out + "/logs/seed_" + std::to_string(s) + ".lcmlog";
+    o.log_channels = log_channels;
     if (snapshots) o.snapshot_dir = out + "/snapshots/seed_" + std::to_string(s);
     SceneOutcome outcome{s, run_full_cycle(o, budget, books)};
     accumulate(outcome, books, tol, &metrics);

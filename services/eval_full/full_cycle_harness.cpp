@@ -274,6 +274,9 @@ struct FullCycleHarness::Impl {
   // ---- bus observers ----
   void on_any(const lcm::ReceiveBuffer* rbuf, const std::string& channel) {
     if (!o.log_images && std::regex_match(channel, log_skip)) return;
+    if (!o.log_channels.empty() &&
+        std::find(o.log_channels.begin(), o.log_channels.end(), channel) == o.log_channels.end())
+      return;
     lcm::LogEvent ev;
     ev.eventnum = log_events++;
     ev.timestamp = comp.now_utime();
@@ -491,6 +494,31 @@ struct FullCycleHarness::Impl {
     const std::string word = m->reason.substr(0, m->reason.find_first_of(" :"));
     if (m->reason != last_gp_reason) trace("GRASP_POINT " + m->reason.substr(0, 200));
     last_gp_reason = m->reason;
+    if (word == "P1_VALID" || word == "P1_INVALID") {
+      // Where the upper shelf's right-most corner really is against P1 and PS (a book pushed back shows as its Z).
+      const ground_truth_t gt = sim->world().model().ground_truth(sim->world().now_utime());
+      const book_truth_t* tb = nullptr;
+      for (const auto& b : gt.books)
+        if (b.place == "upper_shelf" && b.rightmost) tb = &b;
+      if (tb) {
+        const Eigen::Vector3d c = true_grasp(vec3(tb->p1_base)) * 1e3;
+        std::string l = fmt("TRUTH right-most corner (%.1f, ", c.x()) + fmt("%.1f, ", c.y()) + fmt("%.1f) mm", c.z());
+        if (norm_finite(m->p1_grasp) > 0) {
+          const Eigen::Vector3d e = vec3(m->p1_grasp) * 1e3 - c;
+          l += fmt("; P1 - corner (%.1f, ", e.x()) + fmt("%.1f, ", e.y()) + fmt("%.1f) mm", e.z());
+        }
+        if (norm_finite(m->ps_grasp) > 0) l += fmt("; PS.y - corner.y %.1f mm", m->ps_grasp[1] * 1e3 - c.y());
+        trace(l);
+      }
+      std::vector<Eigen::Vector3d> corners;  // the upper shelf's true corners, right-most first
+      for (const auto& b : gt.books)
+        if (b.place == "upper_shelf") corners.push_back(true_grasp(vec3(b.p1_base)) * 1e3);
+      std::sort(corners.begin(), corners.end(), [](const auto& a, const auto& b) { return a.y() > b.y(); });
+      std::string l = "TRUTH upper-shelf corners (x y z mm), right-most first:";
+      for (std::size_t i = 0; i < corners.size() && i < 4; ++i)
+        l += fmt(" (%.0f ", corners[i].x()) + fmt("%.0f ", corners[i].y()) + fmt("%.0f)", corners[i].z());
+      trace(l);
+    }
     if (word == "GRASP" && m->valid) {
       GraspDecisionRecord d;
       d.book_index = status.current_book;

@@ -11,8 +11,11 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <fstream>
 #include <limits>
+#include <sstream>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "common/composition.h"
@@ -302,7 +305,9 @@ TEST_F(ArbiterNodeTest, InvalidP1StartsBwhFromPsAndTakesZFromCartModel) {
   ASSERT_EQ(out.got.size(), 2u);
   EXPECT_TRUE(starts_with(out.got[1].reason, "P1_INVALID")) << out.got[1].reason;
   EXPECT_FALSE(out.got[1].p1_used);
-  expect_vec(out.got[1].gp_grasp, {0.10, 0.255, -0.15}, "BwH start = PS");
+  // BwH starts from PS in X and Y; Z is the front depth the corner servo assumes: P1 grasp (0.25, 0.275, 0.01)
+  // is invalid in Y but its Z lies within invalid_p1_depth_range_m of book_front_z_m 0.01 -> 0.01.
+  expect_vec(out.got[1].gp_grasp, {0.10, 0.255, 0.01}, "BwH start = PS, front depth");
   // P2 grasp (0.24, 0.26, -0.15): 5 mm right of PS -> valid; no P1 -> X as is, Z = book_front_z_m 0.01.
   send("SERVO_REQUEST", request(5000, 2, servo_request_t::BOOK_CORNER, 0));
   send("SERVO_STATUS", status(6000, 2, servo_request_t::BOOK_CORNER, servo_status_t::CONVERGED, {0.45, -0.31, 0.24}));
@@ -310,6 +315,44 @@ TEST_F(ArbiterNodeTest, InvalidP1StartsBwhFromPsAndTakesZFromCartModel) {
   EXPECT_TRUE(starts_with(out.got[2].reason, "GRASP")) << out.got[2].reason;
   EXPECT_FALSE(out.got[2].p1_used);
   expect_vec(out.got[2].gp_grasp, {0.24, 0.26, 0.01}, "gp without P1");
+}
+
+TEST_F(ArbiterNodeTest, AStereoFrontLeftOfPsGivesTheDepthWhenP1IsInvalid) {
+  // The target's front pushed back to grasp Z 0.08, spanning grasp Y 0.230..0.254 and X 0..0.20: in base the
+  // plane x = 0.60 + 0.08 (normal +x), y = -0.05 - Y in [-0.304, -0.280], z = X. PS.y 0.255 -> probe band
+  // Y 0.245..0.253 (stereo_front.probe_left_of_ps_m), inside the region.
+  book_corner_stereo_t c = corner(2000, "god", true, {0.61, -0.325, 0.25});  // P1 2 cm right of PS: invalid
+  plane_region_t r;
+  r.utime = 2000;
+  r.label = 7;
+  r.pixel_count = 300;
+  for (int i = 0; i < 4; ++i) r.bbox_px[i] = 0;
+  r.normal_base[0] = 1;
+  r.normal_base[1] = 0;
+  r.normal_base[2] = 0;
+  r.offset_m = 0.68;
+  const double lo[3] = {0.68, -0.304, 0.0}, hi[3] = {0.68, -0.280, 0.20};
+  for (int i = 0; i < 3; ++i) {
+    r.extent_min_base[i] = lo[i];
+    r.extent_max_base[i] = hi[i];
+  }
+  r.candidate = false;
+  r.reject_reason = "too small";
+  c.regions = {r};
+  c.num_regions = 1;
+  send("MARKERS", markers(1000));
+  send("BOOK_CORNER_STEREO", c);
+  send("SERVO_REQUEST", request(3000, 1, servo_request_t::STRIPE_END));
+  send("SERVO_STATUS", status(4000, 1, servo_request_t::STRIPE_END, servo_status_t::CONVERGED, {0.45, -0.305, 0.10}));
+  ASSERT_EQ(out.got.size(), 2u);
+  EXPECT_TRUE(starts_with(out.got[1].reason, "P1_INVALID")) << out.got[1].reason;
+  expect_vec(out.got[1].gp_grasp, {0.10, 0.255, 0.08}, "BwH start = PS, the stereo front's depth");
+  // P2 grasp (0.24, 0.26, -0.15) -> GP = (0.24, 0.26, 0.08): the pushed front, not P1's 0.01.
+  send("SERVO_REQUEST", request(5000, 2, servo_request_t::BOOK_CORNER, 0));
+  send("SERVO_STATUS", status(6000, 2, servo_request_t::BOOK_CORNER, servo_status_t::CONVERGED, {0.45, -0.31, 0.24}));
+  ASSERT_EQ(out.got.size(), 3u);
+  EXPECT_TRUE(starts_with(out.got[2].reason, "GRASP")) << out.got[2].reason;
+  expect_vec(out.got[2].gp_grasp, {0.24, 0.26, 0.08}, "gp from the stereo front");
 }
 
 TEST_F(ArbiterNodeTest, ServoFailureIsNoGraspAndOpensANewAttempt) {
@@ -460,16 +503,27 @@ TEST(ArbiterConfig, ShippedConfigReadsCompletelyAndBadValuesNameTheKey) {
   }
 }
 
-TEST(ArbiterConfig, ABadInvalidP1DepthRangeNamesTheKey) {
-  std::string text = arbiter_config().dump();
-  const auto pos = text.find("invalid_p1_depth_range_m: 0.15");
-  ASSERT_NE(pos, std::string::npos);
-  text.replace(pos, 30, "invalid_p1_depth_range_m: -0.1");
-  try {
-    ArbiterNode bad(Config::from_string(text, "arbiter.yaml"));
-    FAIL() << "a negative range must be refused";
-  } catch (const ConfigError& e) {
-    EXPECT_NE(std::string(e.what()).find("tolerances.invalid_p1_depth_range_m"), std::string::npos) << e.what();
+TEST(ArbiterConfig, BadDepthKeysNameTheKey) {
+  std::ifstream f(std::string(BOOKGRASP_SOURCE_DIR) + "/config/services/arbiter.yaml");
+  std::stringstream ss;
+  ss << f.rdbuf();
+  const std::string shipped = ss.str();
+  for (const auto& [key, line, bad] : std::vector<std::tuple<std::string, std::string, std::string>>{
+           {"tolerances.invalid_p1_depth_range_m", "invalid_p1_depth_range_m: 0.15", "invalid_p1_depth_range_m: -0.1"},
+           {"stereo_front.probe_left_of_ps_m", "probe_left_of_ps_m: [0.002, 0.010]",
+            "probe_left_of_ps_m: [0.01, 0.002]"},
+           {"stereo_front.depth_range_m", "depth_range_m: [-0.05, 0.20]", "depth_range_m: [0.20, -0.05]"},
+           {"stereo_front.max_tilt_deg", "max_tilt_deg: 20.0", "max_tilt_deg: 95"}}) {
+    std::string text = shipped;
+    const auto pos = text.find(line);
+    ASSERT_NE(pos, std::string::npos) << line;
+    text.replace(pos, line.size(), bad);
+    try {
+      ArbiterNode node(Config::from_string(text, "arbiter.yaml"));
+      ADD_FAILURE() << "accepted " << bad;
+    } catch (const ConfigError& e) {
+      EXPECT_NE(std::string(e.what()).find(key), std::string::npos) << e.what();
+    }
   }
 }
 

@@ -113,8 +113,17 @@ TEST_P(CombinationStrategy, Branch) {
   }
   ASSERT_FALSE(r.steps.empty());
   EXPECT_NE(r.steps.back().decision.find(c.last_decision_contains), std::string::npos) << r.steps.back().decision;
-  // BwH starts from P1 when valid, else from PS (Section 3.1).
-  EXPECT_TRUE(r.bwh_start.isApprox(c.p1_valid ? *c.p1 : c.ps) || !c.ps.allFinite());
+  // BwH starts from P1 when valid, else from PS (Section 3.1); its Z is the front depth the servo assumes, the
+  // one GP.z takes.
+  if (!c.ps.allFinite()) return;
+  if (c.p1_valid) {
+    EXPECT_TRUE(r.bwh_start.isApprox(*c.p1)) << r.bwh_start.transpose();
+  } else {
+    EXPECT_TRUE(r.bwh_start.head<2>().isApprox(c.ps.head<2>())) << r.bwh_start.transpose();
+    if (c.outcome == GraspOutcome::kGrasp) {
+      EXPECT_DOUBLE_EQ(r.bwh_start.z(), c.gp.z());
+    }
+  }
 }
 
 INSTANTIATE_TEST_SUITE_P(Paper, CombinationStrategy, testing::ValuesIn(kCases),
@@ -159,6 +168,36 @@ TEST(CombinationStrategy, AnInvalidP1NearTheModelsFrontGivesTheDepth) {
   in.p1 = V(0.10, 0.080, 0.50);
   r = combine(in, kTol);
   EXPECT_TRUE(r.gp.isApprox(V(0.09, 0.095, 0.42), 1e-12)) << r.gp.transpose();
+}
+
+TEST(CombinationStrategy, TheStereoFrontLeftOfPsComesBeforeAnInvalidP1sDepth) {
+  CombinationTolerances tol = kTol;
+  tol.invalid_p1_depth_range = 0.15;
+  CombinationInputs in;
+  in.ps = kPs;
+  in.p2 = V(0.09, 0.095, 0.45);
+  in.front_z_fallback = 0.42;
+  in.p1 = V(0.10, 0.060, 0.43);  // 4 cm left of PS: an unpushed neighbour's corner
+  in.stereo_front_z = 0.49;      // the target's front, pushed 7 cm back
+  CombinationResult r = combine(in, tol);
+  ASSERT_EQ(outcome_name(r.outcome), outcome_name(GraspOutcome::kGrasp));
+  EXPECT_TRUE(r.gp.isApprox(V(0.09, 0.095, 0.49), 1e-12)) << r.gp.transpose();
+  EXPECT_NE(r.steps.back().decision.find("stereo plane"), std::string::npos) << r.steps.back().decision;
+  // The servo assumes the same depth before P2 exists.
+  EXPECT_DOUBLE_EQ(validate_p1(in, tol).bwh_start.z(), 0.49);
+  // Beyond the range of the model's plane it is not a book front: the invalid P1's depth is next.
+  in.stereo_front_z = 0.58;
+  r = combine(in, tol);
+  EXPECT_TRUE(r.gp.isApprox(V(0.09, 0.095, 0.43), 1e-12)) << r.gp.transpose();
+  // The paper's rule (range 0): the model's plane, for GP and the servo alike.
+  in.stereo_front_z = 0.49;
+  r = combine(in, kTol);
+  EXPECT_TRUE(r.gp.isApprox(V(0.09, 0.095, 0.42), 1e-12)) << r.gp.transpose();
+  EXPECT_DOUBLE_EQ(validate_p1(in, kTol).bwh_start.z(), 0.42);
+  // No model plane and no usable depth: the servo's depth is unknown (NaN), and no grasp.
+  in.front_z_fallback.reset();
+  EXPECT_TRUE(std::isnan(validate_p1(in, tol).bwh_start.z()));
+  EXPECT_EQ(outcome_name(combine(in, tol).outcome), outcome_name(GraspOutcome::kNoGrasp));
 }
 
 TEST(CombinationStrategy, P1ValidityBoundaryAndTrace) {

@@ -73,7 +73,9 @@ class FakeLibrary {
   int next_region_once = 0;                  ///< BwH rank 0 answers NEXT_REGION this many times
   int no_grasp_once = 0;                     ///< BwH answers NO_GRASP this many times
   int missed_grasps = 0;                     ///< the gripper closes on nothing this many times
-  std::optional<double> invalid_p1_z;        ///< P1 checks answer P1_INVALID with a P1 2 cm off PS at this Z
+  /// P1 checks answer P1_INVALID (a P1 2 cm off PS) with this as the arbiter's front depth for the corner servo
+  /// (gp_grasp's Z; NaN = the arbiter knew none)
+  std::optional<double> invalid_p1_front_z;
   int missed_holder_grasps = 0;              ///< ... on the holder (the book stays there)
   bool servo_silent = false;                 ///< servo never answers (timeouts)
   bool user_answers = true;                  ///< sends "done" in WAIT_USER after 1 s
@@ -183,6 +185,7 @@ class FakeLibrary {
   }
 
   static constexpr double kP1FrontZ = 0.012;  ///< the books' fronts as BwS measures them (P1.z), grasp frame
+  static constexpr double kModelFrontZ = 0.01;  ///< the arbiter's model plane (arbiter.yaml cart.book_front_z_m)
   bookgrasp::DecisionEvent p1_check(int64_t request_id) const {
     bookgrasp::DecisionEvent d;
     d.utime = t;
@@ -192,16 +195,16 @@ class FakeLibrary {
     if (ps) d.ps_grasp = *ps;
     if (!ps) {
       d.outcome = "NEED_PS";
-    } else if (!upper.empty() && invalid_p1_z) {
+    } else if (!upper.empty() && invalid_p1_front_z) {
       d.outcome = "P1_INVALID";
-      d.gp_grasp = *ps;
-      d.p1_grasp = Eigen::Vector3d(upper.front().height, ps->y() + 0.02, *invalid_p1_z);
+      d.gp_grasp = Eigen::Vector3d(ps->x(), ps->y(), *invalid_p1_front_z);
+      d.p1_grasp = Eigen::Vector3d(upper.front().height, ps->y() + 0.02, kP1FrontZ);
     } else if (!upper.empty()) {
       d.outcome = "P1_VALID";
       d.gp_grasp = Eigen::Vector3d(upper.front().height, upper.front().right_y, kP1FrontZ);
     } else {
       d.outcome = "P1_INVALID";
-      d.gp_grasp = *ps;
+      d.gp_grasp = Eigen::Vector3d(ps->x(), ps->y(), kModelFrontZ);
     }
     d.reason = d.outcome + ": fake arbiter";
     return d;

@@ -252,23 +252,23 @@ TEST(LibraryCycle, AMissedGraspFromTheHolderBacksOutStraightBeforePlanning) {
   EXPECT_EQ(cycle.progress().failures, 1);
 }
 
-TEST(LibraryCycle, AnInvalidP1NearTheModelsFrontSetsTheCornerServosDepth) {
-  // coordinator.yaml: book_front_z_m 0.01, invalid_p1_depth_range_m 0.15, bwh_start_z_m -0.10.
+TEST(LibraryCycle, TheArbitersFrontDepthSetsTheCornerServosStandoff) {
+  // coordinator.yaml: book_front_z_m 0.01 (when the arbiter gives no depth), bwh_start_z_m -0.10.
   const CycleSettings cs = settings();
   ASSERT_NEAR(cs.geometry.book_front_z, 0.01, 1e-12);
-  ASSERT_NEAR(cs.geometry.invalid_p1_depth_range, 0.15, 1e-12);
-  for (const auto& [p1_z, standoff] : {std::pair{0.09, 0.19}, std::pair{0.20, 0.11}}) {
+  ASSERT_NEAR(cs.geometry.bwh_start_z, -0.10, 1e-12);
+  for (const auto& [front_z, standoff] : {std::pair{0.09, 0.19}, std::pair{double(NAN), 0.11}}) {
     FakeLibrary w(three_books());
-    w.invalid_p1_z = p1_z;  // 0.09: 8 cm behind the model's plane (pushed back); 0.20: 19 cm, beyond the range
+    w.invalid_p1_front_z = front_z;  // 0.09: the target pushed 8 cm back; NaN: unknown, the model's plane
     LibraryCycle cycle(cs, std::nullopt);
     w.run(cycle, [&] { return done_or_aborted(cycle); });
     int corner_requests = 0;
     for (const auto& q : w.requests)
       if (q.kind == CycleRequest::Kind::kServo && q.servo_mode == 1) {
         ++corner_requests;
-        EXPECT_NEAR(q.fixed_depth, standoff, 1e-12) << "P1.z " << p1_z;
+        EXPECT_NEAR(q.fixed_depth, standoff, 1e-12) << "front " << front_z;
       }
-    EXPECT_GE(corner_requests, 1) << "P1.z " << p1_z;
+    EXPECT_GE(corner_requests, 1) << "front " << front_z;
   }
 }
 
@@ -277,10 +277,9 @@ TEST(LibraryCycle, BadDepthKeysNameTheKey) {
   std::stringstream ss;
   ss << f.rdbuf();
   const std::string shipped = ss.str();
-  for (const auto& [key, line, bad] :
-       {std::tuple<std::string, std::string, std::string>{"grasp.deep_front_z_m", "deep_front_z_m: 0.035",
-                                                          "deep_front_z_m: 0.9"},
-        {"servo.invalid_p1_depth_range_m", "invalid_p1_depth_range_m: 0.15", "invalid_p1_depth_range_m: -1"}}) {
+  for (const auto& [key, line, bad] : {std::tuple<std::string, std::string, std::string>{
+                                           "grasp.deep_front_z_m", "deep_front_z_m: 0.035", "deep_front_z_m: 0.9"},
+                                       {"servo.book_front_z_m", "book_front_z_m: 0.01", "book_front_z_m: 0.5"}}) {
     std::string text = shipped;
     const auto pos = text.find(line);
     ASSERT_NE(pos, std::string::npos) << line;
