@@ -124,6 +124,30 @@ TEST(Scene, BooksStandOnTheShelfWithoutInterpenetrating) {
   }
 }
 
+// pushed_fronts.yaml (the BwS stress set, docs/BWS.md): fore-edges 0-14 cm behind the shelf's front edge, many of
+// them deeper than far_cart.yaml's 2 cm, every book still on the shelf and clear of the rear board.
+TEST(Scene, PushedFrontsStandUpTo14CmDeep) {
+  const std::string file = std::string(BOOKGRASP_SOURCE_DIR) + "/config/scenes/pushed_fronts.yaml";
+  int books = 0, deeper_than_2cm = 0;
+  for (uint64_t seed = 1; seed <= 20; ++seed) {
+    const Scene s = load_scene(file, seed);
+    const double front = s.cart_pose.translation().x(), back = front + s.shelf_depth_m;
+    for (const Book& b : s.books) {
+      double fore_edge = 1e9, rear = -1e9;
+      for (const auto& p : book_corners(b.pose, b.width_m, b.height_m, b.depth_m)) {
+        fore_edge = std::min(fore_edge, p.x());
+        rear = std::max(rear, p.x());
+      }
+      EXPECT_GE(fore_edge - front, -1e-9) << "seed " << seed;
+      EXPECT_LE(fore_edge - front, 0.14 + 0.01) << "seed " << seed;  // + the lean's few millimetres
+      EXPECT_LE(rear, back - 0.001) << "seed " << seed;
+      ++books;
+      if (fore_edge - front > 0.02 + 0.005) ++deeper_than_2cm;
+    }
+  }
+  EXPECT_GT(deeper_than_2cm, books / 2) << deeper_than_2cm << " of " << books;
+}
+
 TEST(Scene, RightmostBookIsAtARandomPosition) {
   double ymin = 1e9, ymax = -1e9;
   for (uint64_t seed = 0; seed < 30; ++seed) {
