@@ -145,13 +145,21 @@ TEST(CombinationStrategy, TheLeftNeighbourRuleCanBeSwitchedOffForThePapersRules)
   EXPECT_NEAR(ours.steps[ours.steps.size() - 2].value, -0.02, 1e-12);
 }
 
-TEST(CombinationStrategy, AnInvalidP1NearTheModelsFrontGivesTheDepth) {
-  CombinationTolerances tol = kTol;
-  tol.invalid_p1_depth_range = 0.15;
+/// PS, a P2 5 mm left of it and the model's front plane at Z 0.42, for the rules that give GP.z without a valid P1;
+/// with `tol` ranging 0.15 around that plane (arbiter.yaml tolerances.invalid_p1_depth_range_m).
+CombinationInputs depth_case(CombinationTolerances* tol) {
+  *tol = kTol;
+  tol->invalid_p1_depth_range = 0.15;
   CombinationInputs in;
   in.ps = kPs;
   in.p2 = V(0.09, 0.095, 0.45);
   in.front_z_fallback = 0.42;
+  return in;
+}
+
+TEST(CombinationStrategy, AnInvalidP1NearTheModelsFrontGivesTheDepth) {
+  CombinationTolerances tol;
+  CombinationInputs in = depth_case(&tol);
   // P1 2 cm from PS (invalid in Y), 8 cm deeper than the model's plane: GP.z = P1.z; X and Y still from P2.
   in.p1 = V(0.10, 0.080, 0.50);
   CombinationResult r = combine(in, tol);
@@ -171,12 +179,8 @@ TEST(CombinationStrategy, AnInvalidP1NearTheModelsFrontGivesTheDepth) {
 }
 
 TEST(CombinationStrategy, TheStereoFrontLeftOfPsComesBeforeAnInvalidP1sDepth) {
-  CombinationTolerances tol = kTol;
-  tol.invalid_p1_depth_range = 0.15;
-  CombinationInputs in;
-  in.ps = kPs;
-  in.p2 = V(0.09, 0.095, 0.45);
-  in.front_z_fallback = 0.42;
+  CombinationTolerances tol;
+  CombinationInputs in = depth_case(&tol);
   in.p1 = V(0.10, 0.060, 0.43);  // 4 cm left of PS: an unpushed neighbour's corner
   in.stereo_front_z = 0.49;      // the target's front, pushed 7 cm back
   CombinationResult r = combine(in, tol);
