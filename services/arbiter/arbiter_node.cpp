@@ -295,8 +295,7 @@ void ArbiterNode::publish_p1_check(int64_t utime, int64_t request_id) {
   const CombinationResult r = validate_p1(in, s_.tolerances);
   for (const ValidationStep& st : r.steps) m.steps.push_back(to_msg(st, utime));
   if (!r.p1_valid) {  // the depth the corner servo assumes (GP.z will take the same), as gp_grasp's Z
-    ValidationStep z_step;
-    front_depth_without_p1(in, s_.tolerances, &z_step);
+    ValidationStep z_step = r.front_depth_step;
     z_step.rule = "front depth for BwH";
     m.steps.push_back(to_msg(z_step, utime));
   }

@@ -61,8 +61,7 @@ CombinationResult validate_p1(const CombinationInputs& in, const CombinationTole
   CombinationResult r;
   r.bwh_start = in.ps;
   if (!in.ps.allFinite()) return fail(r, "inputs", "PS is not finite: no reference for the right-most book");
-  ValidationStep z_step;
-  r.bwh_start.z() = front_depth_without_p1(in, tol, &z_step).value_or(NAN);  // replaced by P1.z when P1 is valid
+  r.bwh_start.z() = front_depth_without_p1(in, tol, &r.front_depth_step).value_or(NAN);  // P1.z when P1 is valid
   if (!in.p1) {
     r.steps.push_back(step("P1.y vs PS.y", NAN, tol.p1_ps_y, false, "no P1 from BwS: ignore BwS, BwH starts from PS"));
     return r;

@@ -72,6 +72,8 @@ struct CombinationResult {
   /// Where BwH should start servoing: P1 if valid, else PS (Section 3.1) in X and Y. Its Z is the depth of the
   /// book's front the servo should assume: P1.z if valid, else front_depth_without_p1 (NaN when unknown).
   Eigen::Vector3d bwh_start = Eigen::Vector3d::Zero();
+  /// Where bwh_start's Z came from when P1 is not valid (front_depth_without_p1's step); not in `steps`.
+  ValidationStep front_depth_step;
   std::vector<ValidationStep> steps;
 };
 

@@ -111,7 +111,6 @@ struct DecisionEvent {
   int next_rank = 0;    ///< NEXT_REGION
   bool valid = false;
   bool p1_present = false;  ///< p1_grasp finite
-  Eigen::Vector3d p1_grasp = Eigen::Vector3d::Zero();  ///< BwS's P1 (when p1_present), valid or not
   Eigen::Isometry3d gp_base = Eigen::Isometry3d::Identity();
   Eigen::Vector3d gp_grasp = Eigen::Vector3d::Zero();
   bool ps_present = false;

@@ -198,7 +198,6 @@ class FakeLibrary {
     } else if (!upper.empty() && invalid_p1_front_z) {
       d.outcome = "P1_INVALID";
       d.gp_grasp = Eigen::Vector3d(ps->x(), ps->y(), *invalid_p1_front_z);
-      d.p1_grasp = Eigen::Vector3d(upper.front().height, ps->y() + 0.02, kP1FrontZ);
     } else if (!upper.empty()) {
       d.outcome = "P1_VALID";
       d.gp_grasp = Eigen::Vector3d(upper.front().height, upper.front().right_y, kP1FrontZ);
