@@ -9,6 +9,15 @@
 namespace bookgrasp {
 namespace {
 
+/// The default cart's grasp axes in base: X (up) = base z, Y (right) = -base y, Z (into the shelf) = base x.
+Eigen::Matrix3d grasp_axes() {
+  Eigen::Matrix3d r;
+  r.col(0) = Eigen::Vector3d(0, 0, 1);
+  r.col(1) = Eigen::Vector3d(0, -1, 0);
+  r.col(2) = Eigen::Vector3d(1, 0, 0);
+  return r;
+}
+
 CycleGeometry geometry() {
   CycleGeometry g;
   g.bwh_start_z = -0.10;
@@ -38,9 +47,7 @@ TEST(CycleGeometry, APushedBackFrontKeepsThePreGraspInFrontOfTheShelf) {
   g.grasp_offset_y = 0.015;
   // GP frame rotated: its z (into the shelf) along base +x, its x (up) along base +z.
   Eigen::Isometry3d gp = Eigen::Isometry3d::Identity();
-  gp.linear().col(0) = Eigen::Vector3d(0, 0, 1);
-  gp.linear().col(1) = Eigen::Vector3d(0, -1, 0);
-  gp.linear().col(2) = Eigen::Vector3d(1, 0, 0);
+  gp.linear() = grasp_axes();
   gp.translation() = Eigen::Vector3d(0.80, -0.20, 0.20);
   // A front at 2 cm: 9 cm straight back along -z, offsets along x (up) and y.
   const Eigen::Vector3d usual = pre_grasp_pose(gp, 0.02, g).translation();
@@ -92,9 +99,7 @@ TEST(CycleGeometry, ExtractEndsAtTheSameHeightAndDepthWhereverItStarts) {
   g.extract_retreat = 0.02;
   // The grasp frame: X = base z, Y = -base y, Z = base x (as the default cart), origin (0.6, -0.05, 0).
   Eigen::Isometry3d f = Eigen::Isometry3d::Identity();
-  f.linear().col(0) = Eigen::Vector3d(0, 0, 1);
-  f.linear().col(1) = Eigen::Vector3d(0, -1, 0);
-  f.linear().col(2) = Eigen::Vector3d(1, 0, 0);
+  f.linear() = grasp_axes();
   f.translation() = Eigen::Vector3d(0.6, -0.05, 0.0);
   const double tcp_height = 0.20, grasp_z = 0.04;  // TCP at grasp X 0.20, Z 0.04 when it closed
   Eigen::Isometry3d at_grasp = f;
