@@ -396,6 +396,10 @@ std::optional<double> ArbiterNode::stereo_front_z(const Eigen::Vector3d& ps_gras
   std::vector<FrontPlane> planes;
   planes.reserve(regions.size());
   for (const plane_region_t& g : regions) {
+    // A region with a non-finite field is no plane to measure (and would leave a box of its finite corners).
+    if (!finite3(g.normal_base) || !std::isfinite(g.offset_m) || !finite3(g.extent_min_base) ||
+        !finite3(g.extent_max_base))
+      continue;
     FrontPlane p;
     const Eigen::Vector3d n(g.normal_base[0], g.normal_base[1], g.normal_base[2]);
     p.normal = to_grasp_axes * n;

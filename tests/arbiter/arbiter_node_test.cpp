@@ -317,11 +317,10 @@ TEST_F(ArbiterNodeTest, InvalidP1StartsBwhFromPsAndTakesZFromCartModel) {
   expect_vec(out.got[2].gp_grasp, {0.24, 0.26, 0.01}, "gp without P1");
 }
 
-TEST_F(ArbiterNodeTest, AStereoFrontLeftOfPsGivesTheDepthWhenP1IsInvalid) {
-  // The target's front pushed back to grasp Z 0.08, spanning grasp Y 0.230..0.254 and X 0..0.20: in base the
-  // plane x = 0.60 + 0.08 (normal +x), y = -0.05 - Y in [-0.304, -0.280], z = X. PS.y 0.255 -> probe band
-  // Y 0.245..0.253 (stereo_front.probe_left_of_ps_m), inside the region.
-  book_corner_stereo_t c = corner(2000, "god", true, {0.61, -0.325, 0.25});  // P1 2 cm right of PS: invalid
+// The target's front pushed back to grasp Z 0.08, spanning grasp Y 0.230..0.254 and X 0..0.20: in base the
+// plane x = 0.60 + 0.08 (normal +x), y = -0.05 - Y in [-0.304, -0.280], z = X. With PS.y 0.255 the probe band
+// Y 0.245..0.253 (stereo_front.probe_left_of_ps_m) lies inside it.
+plane_region_t pushed_front_region() {
   plane_region_t r;
   r.utime = 2000;
   r.label = 7;
@@ -338,21 +337,37 @@ TEST_F(ArbiterNodeTest, AStereoFrontLeftOfPsGivesTheDepthWhenP1IsInvalid) {
   }
   r.candidate = false;
   r.reject_reason = "too small";
-  c.regions = {r};
-  c.num_regions = 1;
-  send("MARKERS", markers(1000));
-  send("BOOK_CORNER_STEREO", c);
-  send("SERVO_REQUEST", request(3000, 1, servo_request_t::STRIPE_END));
-  send("SERVO_STATUS", status(4000, 1, servo_request_t::STRIPE_END, servo_status_t::CONVERGED, {0.45, -0.305, 0.10}));
-  ASSERT_EQ(out.got.size(), 2u);
-  EXPECT_TRUE(starts_with(out.got[1].reason, "P1_INVALID")) << out.got[1].reason;
-  expect_vec(out.got[1].gp_grasp, {0.10, 0.255, 0.08}, "BwH start = PS, the stereo front's depth");
-  // P2 grasp (0.24, 0.26, -0.15) -> GP = (0.24, 0.26, 0.08): the pushed front, not P1's 0.01.
-  send("SERVO_REQUEST", request(5000, 2, servo_request_t::BOOK_CORNER, 0));
-  send("SERVO_STATUS", status(6000, 2, servo_request_t::BOOK_CORNER, servo_status_t::CONVERGED, {0.45, -0.31, 0.24}));
-  ASSERT_EQ(out.got.size(), 3u);
-  EXPECT_TRUE(starts_with(out.got[2].reason, "GRASP")) << out.got[2].reason;
-  expect_vec(out.got[2].gp_grasp, {0.24, 0.26, 0.08}, "gp from the stereo front");
+  return r;
+}
+
+TEST_F(ArbiterNodeTest, AStereoFrontLeftOfPsGivesTheDepthWhenP1IsInvalid) {
+  const plane_region_t good = pushed_front_region();
+  plane_region_t bad = good;
+  bad.extent_min_base[0] = NAN;  // one bad field: not a plane to measure (its finite corners alone gave 0.08)
+  // P1 2 cm right of PS: invalid; its own Z 0.01 is the depth without a usable region.
+  for (const auto& [region, front_z] : {std::pair{good, 0.08}, std::pair{bad, 0.01}}) {
+    SCOPED_TRACE("front " + std::to_string(front_z));
+    out.got.clear();
+    book_corner_stereo_t c = corner(2000, "god", true, {0.61, -0.325, 0.25});
+    c.regions = {region};
+    c.num_regions = 1;
+    send("SERVO_REQUEST", request(1500, 0, servo_request_t::CANCEL));  // a fresh attempt for each case
+    send("MARKERS", markers(1000));
+    send("BOOK_CORNER_STEREO", c);
+    send("SERVO_REQUEST", request(3000, 1, servo_request_t::STRIPE_END));
+    send("SERVO_STATUS",
+         status(4000, 1, servo_request_t::STRIPE_END, servo_status_t::CONVERGED, {0.45, -0.305, 0.10}));
+    ASSERT_EQ(out.got.size(), 2u);
+    EXPECT_TRUE(starts_with(out.got[1].reason, "P1_INVALID")) << out.got[1].reason;
+    expect_vec(out.got[1].gp_grasp, {0.10, 0.255, front_z}, "BwH start = PS, the front's depth");
+    // P2 grasp (0.24, 0.26, -0.15) -> GP = (0.24, 0.26, front depth).
+    send("SERVO_REQUEST", request(5000, 2, servo_request_t::BOOK_CORNER, 0));
+    send("SERVO_STATUS",
+         status(6000, 2, servo_request_t::BOOK_CORNER, servo_status_t::CONVERGED, {0.45, -0.31, 0.24}));
+    ASSERT_EQ(out.got.size(), 3u);
+    EXPECT_TRUE(starts_with(out.got[2].reason, "GRASP")) << out.got[2].reason;
+    expect_vec(out.got[2].gp_grasp, {0.24, 0.26, front_z}, "gp from the front's depth");
+  }
 }
 
 TEST_F(ArbiterNodeTest, ServoFailureIsNoGraspAndOpensANewAttempt) {
