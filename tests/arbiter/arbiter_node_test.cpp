@@ -355,15 +355,13 @@ TEST_F(ArbiterNodeTest, AStereoFrontLeftOfPsGivesTheDepthWhenP1IsInvalid) {
     send("MARKERS", markers(1000));
     send("BOOK_CORNER_STEREO", c);
     send("SERVO_REQUEST", request(3000, 1, servo_request_t::STRIPE_END));
-    send("SERVO_STATUS",
-         status(4000, 1, servo_request_t::STRIPE_END, servo_status_t::CONVERGED, {0.45, -0.305, 0.10}));
+    send("SERVO_STATUS", status(4000, 1, servo_request_t::STRIPE_END, servo_status_t::CONVERGED, {0.45, -0.305, 0.10}));
     ASSERT_EQ(out.got.size(), 2u);
     EXPECT_TRUE(starts_with(out.got[1].reason, "P1_INVALID")) << out.got[1].reason;
     expect_vec(out.got[1].gp_grasp, {0.10, 0.255, front_z}, "BwH start = PS, the front's depth");
     // P2 grasp (0.24, 0.26, -0.15) -> GP = (0.24, 0.26, front depth).
     send("SERVO_REQUEST", request(5000, 2, servo_request_t::BOOK_CORNER, 0));
-    send("SERVO_STATUS",
-         status(6000, 2, servo_request_t::BOOK_CORNER, servo_status_t::CONVERGED, {0.45, -0.31, 0.24}));
+    send("SERVO_STATUS", status(6000, 2, servo_request_t::BOOK_CORNER, servo_status_t::CONVERGED, {0.45, -0.31, 0.24}));
     ASSERT_EQ(out.got.size(), 3u);
     EXPECT_TRUE(starts_with(out.got[2].reason, "GRASP")) << out.got[2].reason;
     expect_vec(out.got[2].gp_grasp, {0.24, 0.26, front_z}, "gp from the front's depth");
