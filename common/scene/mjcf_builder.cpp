@@ -22,6 +22,11 @@ std::string num(double v) {
   return os.str();
 }
 std::string vec(const Eigen::Vector3d& v) { return num(v.x()) + " " + num(v.y()) + " " + num(v.z()); }
+std::string nums(const std::vector<double>& v) {
+  std::string s;
+  for (double x : v) s += (s.empty() ? "" : " ") + num(x);
+  return s;
+}
 std::string quat(const Eigen::Matrix3d& r) {
   Eigen::Quaterniond q(r);
   q.normalize();
@@ -144,7 +149,9 @@ class RobotWriter {
       xml_ << pad << "  <geom name=\"" << name << "\" type=\"" << type << "\" size=\"" << size << "\" "
            << pose_attr(gp) << " rgba=\"" << rgba(colour) << "\" " << kRobotContact;
       if (finger)
-        xml_ << " condim=\"4\" friction=\"" << num(scene_.physics.finger_friction) << " 0.02 0.0001\"";
+        xml_ << " condim=\"4\" friction=\"" << num(scene_.physics.finger_friction) << " 0.02 0.0001\" solref=\""
+             << nums(scene_.physics.finger_solref) << "\" solimp=\"" << nums(scene_.physics.finger_solimp)
+             << "\" solmix=\"1000\"";  // the contact takes the plate's solref/solimp, not a mix with the book's
       xml_ << " group=\"2\"/>\n";
     }
     if (l->name == "gripper") xml_ << pad << "  <site name=\"gripper\" size=\"0.005\" rgba=\"1 0 0 0\"/>\n";
@@ -295,7 +302,8 @@ MjcfDocument build_mjcf(const Scene& s) {
 
   x << "  <equality>\n"
     << "    <joint name=\"finger_coupling\" joint1=\"gripper_finger_right_joint\" joint2=\"gripper_finger_left_joint\" "
-       "polycoef=\"0 1 0 0 0\"/>\n"
+       "polycoef=\"0 1 0 0 0\" solref=\""
+    << nums(ph.gripper_coupling_solref) << "\"/>\n"
     << "  </equality>\n";
   x << "  <actuator>\n";
   for (const auto& [joint, range] : robot.limits) {

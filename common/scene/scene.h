@@ -98,6 +98,12 @@ struct Physics {
   double gripper_kp = 2000;         ///< N/m on the plate gap
   double gripper_damping = 20;      ///< N s/m per finger
   double gripper_max_force_n = 100; ///< default force limit of the gripper actuator
+  /// MuJoCo solref (time constant s, damping ratio) of the equality that couples the fingers (the PG70's screw).
+  std::vector<double> gripper_coupling_solref{0.004, 1.0};
+  /// MuJoCo solref (time constant s, damping ratio) of the plates' contacts; they override the other geom's.
+  std::vector<double> finger_solref{0.004, 1.0};
+  /// MuJoCo solimp (dmin, dmax, width m) of the plates' contacts; they override the other geom's.
+  std::vector<double> finger_solimp{0.99, 0.999, 0.001};
   double finger_friction = 1.0;
   double book_friction = 0.35;
   double shelf_friction = 0.4;

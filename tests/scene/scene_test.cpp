@@ -1,6 +1,7 @@
 // Tests of the scene generator (common/scene/scene.h) against geometric facts.
 #include "common/scene/scene.h"
 
+#include <array>
 #include <cmath>
 #include <fstream>
 #include <sstream>
@@ -257,6 +258,26 @@ TEST(Scene, ANegativeLedgeExtensionNamesTheKey) {
     FAIL() << "no error for a negative ledge extension";
   } catch (const ConfigError& e) {
     EXPECT_NE(std::string(e.what()).find("holder.ledge_extension_right_m"), std::string::npos) << e.what();
+  }
+}
+
+TEST(Scene, BadGripperContactKeysAreNamed) {
+  for (const auto& [from, to, key] : std::vector<std::array<std::string, 3>>{
+           {"finger_solref: [0.004, 1.0]", "finger_solref: [0.003, 1.0]", "physics.finger_solref"},
+           {"gripper_coupling_solref: [0.004, 1.0]", "gripper_coupling_solref: [0.004, 0.0]",
+            "physics.gripper_coupling_solref"},
+           {"finger_solimp: [0.99, 0.999, 0.001]", "finger_solimp: [0.99, 0.9, 0.001]", "physics.finger_solimp"},
+           {"finger_solimp: [0.99, 0.999, 0.001]", "finger_solimp: [0.99, 0.999]", "finger_solimp"}}) {
+    std::string yaml = read_file(kScene);
+    const auto pos = yaml.find(from);
+    ASSERT_NE(pos, std::string::npos) << from;
+    yaml.replace(pos, from.size(), to);
+    try {
+      generate_scene(Config::from_string(yaml, "test.yaml"), 1, std::string(BOOKGRASP_SOURCE_DIR) + "/config/scenes");
+      ADD_FAILURE() << "no error for " << to;
+    } catch (const ConfigError& e) {
+      EXPECT_NE(std::string(e.what()).find(key), std::string::npos) << e.what();
+    }
   }
 }
 
