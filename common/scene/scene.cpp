@@ -461,15 +461,16 @@ Scene generate_scene(const Config& root, uint64_t seed, const std::string& base_
     auto solref = [&](const char* key, std::vector<double>& v) {
       v = c.get_vector(key, 2);
       if (!(v[0] >= 2 * p.timestep_s && v[0] < 10 && v[1] > 0 && v[1] < 100))
-        throw ConfigError(root.source() + ": physics." + key + " must be [time constant s in [2 x timestep_s = " +
-                          std::to_string(2 * p.timestep_s) +
+        throw ConfigError(root.source() + ": physics." + key +
+                          " must be [time constant s in [2 x timestep_s = " + std::to_string(2 * p.timestep_s) +
                           ", 10) (MuJoCo raises a shorter one to that), damping ratio in (0, 100)]");
     };
     solref("gripper_coupling_solref", p.gripper_coupling_solref);
     solref("finger_solref", p.finger_solref);
     p.finger_solimp = c.get_vector("finger_solimp", 3);
     if (const auto& v = p.finger_solimp; !(v[0] > 0 && v[0] <= v[1] && v[1] < 1 && v[2] > 0 && v[2] < 1))
-      throw ConfigError(root.source() + ": physics.finger_solimp must be [dmin, dmax, width m] with 0 < dmin <= "
+      throw ConfigError(root.source() +
+                        ": physics.finger_solimp must be [dmin, dmax, width m] with 0 < dmin <= "
                         "dmax < 1 and 0 < width < 1");
     p.book_friction = c.get_double("book_friction", 0, 5);
     p.shelf_friction = c.get_double("shelf_friction", 0, 5);

@@ -197,7 +197,8 @@ class ScriptedGrasp : public ::testing::TestWithParam<int> {
     Eigen::Isometry3d p = Eigen::Isometry3d::Identity();
     for (int r = 0; r < 3; ++r)
       for (int c = 0; c < 3; ++c) p.linear()(r, c) = d->site_xmat[9 * site_ + 3 * r + c];
-    p.translation() = Eigen::Vector3d(d->site_xpos[3 * site_], d->site_xpos[3 * site_ + 1], d->site_xpos[3 * site_ + 2]);
+    p.translation() =
+        Eigen::Vector3d(d->site_xpos[3 * site_], d->site_xpos[3 * site_ + 1], d->site_xpos[3 * site_ + 2]);
     return p;
   }
   Eigen::Vector3d site_pos() const { return site_pose().translation(); }
@@ -349,9 +350,10 @@ TEST_P(ScriptedGrasp, EachPlatePressesWithTheCommandedForce) {
   wait(1);
   auto [l1, r1] = plate_forces();
   const double width1 = w_->model().gripper_width();
-  std::printf("seed %lu width %.4f: at grasp L %.1f R %.1f N width %.2f mm under; lifted L %.1f R %.1f N %.2f mm under\n",
-              static_cast<unsigned long>(seed_), book().width_m, l0, r0, (book().width_m - width0) * 1e3, l1, r1,
-              (book().width_m - width1) * 1e3);
+  std::printf(
+      "seed %lu width %.4f: at grasp L %.1f R %.1f N width %.2f mm under; lifted L %.1f R %.1f N %.2f mm under\n",
+      static_cast<unsigned long>(seed_), book().width_m, l0, r0, (book().width_m - width0) * 1e3, l1, r1,
+      (book().width_m - width1) * 1e3);
   for (double f : {l0, r0, l1, r1}) EXPECT_NEAR(f, kForce, 0.1 * kForce);
   EXPECT_NEAR(width0, book().width_m, 0.001);
   EXPECT_NEAR(width1, book().width_m, 0.001);
