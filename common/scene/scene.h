@@ -101,9 +101,9 @@ struct Physics {
   /// MuJoCo solref (time constant s, damping ratio) of the equality that couples the fingers (the PG70's screw).
   std::vector<double> gripper_coupling_solref{0.004, 1.0};
   /// MuJoCo solref (time constant s, damping ratio) of the plates' contacts; they override the other geom's.
-  std::vector<double> finger_solref{0.004, 1.0};
+  std::vector<double> finger_solref{0.01, 1.0};
   /// MuJoCo solimp (dmin, dmax, width m) of the plates' contacts; they override the other geom's.
-  std::vector<double> finger_solimp{0.99, 0.999, 0.001};
+  std::vector<double> finger_solimp{0.95, 0.99, 0.001};
   double finger_friction = 1.0;
   double book_friction = 0.35;
   double shelf_friction = 0.4;

@@ -69,6 +69,8 @@ ArbiterSettings ArbiterSettings::from_config(const Config& root) {
   s.tolerances.max_rank = root.get_int("tolerances.max_rank", 1, 50);
   s.tolerances.p1_over_other_book = root.get<bool>("tolerances.p1_over_other_book");
   s.tolerances.invalid_p1_depth_range = root.get_double("tolerances.invalid_p1_depth_range_m", 0.0, 0.36);
+  s.tolerances.use_hand_corner = root.get<bool>("hand_corner.enabled");
+  s.tolerances.hand_corner_max_y_from_p2 = root.get_double("hand_corner.max_y_from_p2_m", 0.0, 0.1);
   s.use_stereo_front = root.get<bool>("stereo_front.enabled");
   const std::vector<double> band = root.get_vector("stereo_front.probe_left_of_ps_m", 2);
   if (!(band[0] >= 0 && band[0] < band[1] && band[1] <= 0.1))
@@ -337,6 +339,8 @@ void ArbiterNode::decide(const servo_status_t& msg) {
     const Eigen::Isometry3d p2 = pose_to_isometry(msg.converged_pose);
     in.p2 = to_grasp(p2.translation());
     put(m.p2_grasp, *in.p2);
+    if (msg.corner_triangulated)
+      in.hand_corner = to_grasp(Eigen::Vector3d(msg.corner_base[0], msg.corner_base[1], msg.corner_base[2]));
     const Eigen::Vector3d xg = frame_->linear().transpose() * p2.linear().col(0);
     slope = std::atan2(xg.y(), xg.x());
   }

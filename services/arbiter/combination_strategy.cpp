@@ -88,7 +88,29 @@ CombinationResult combine(const CombinationInputs& in, const CombinationToleranc
   if (r.outcome == GraspOutcome::kNoGrasp && !r.steps.empty() && r.steps.back().rule == "inputs") return r;
   if (!in.p2) return fail(r, "P2", "no P2: BwH servoing did not converge");
   if (!in.p2->allFinite()) return fail(r, "P2", "P2 is not finite");
-  const Eigen::Vector3d& p2 = *in.p2;
+  Eigen::Vector3d p2 = *in.p2;
+  // Not in the paper: R located by the hand camera replaces P2.x (measured at R's depth) and gives GP.z.
+  bool hand = false;
+  if (tol.use_hand_corner && in.hand_corner) {
+    const Eigen::Vector3d& h = *in.hand_corner;
+    const double dy = h.y() - p2.y();
+    const double dz = in.front_z_fallback ? h.z() - *in.front_z_fallback : 0.0;
+    if (!h.allFinite()) {
+      r.steps.push_back(step("hand corner", NAN, 0.0, false, "R's triangulation is not finite: not used"));
+    } else if (std::abs(dy) > tol.hand_corner_max_y_from_p2) {
+      r.steps.push_back(step("hand corner Y vs P2.y", dy, tol.hand_corner_max_y_from_p2, false,
+                             "R triangulated " + mm(dy) + " from P2 in Y: not the corner the servo centred, not used"));
+    } else if (tol.invalid_p1_depth_range > 0 && std::abs(dz) > tol.invalid_p1_depth_range) {
+      r.steps.push_back(step("hand corner Z vs model front", dz, tol.invalid_p1_depth_range, false,
+                             "R triangulated " + mm(dz) + " from the model's front plane: not used"));
+    } else {
+      hand = true;
+      r.steps.push_back(step("hand corner", dy, tol.hand_corner_max_y_from_p2, true,
+                             "R triangulated by the hand camera: P2.x " + mm(p2.x()) + " -> " + mm(h.x()) +
+                                 " at its depth " + mm(h.z())));
+      p2.x() = h.x();
+    }
+  }
 
   // The reference for P2: P1 when valid, else PS (the paper restarts BwH from PS).
   const Eigen::Vector3d ref = r.p1_valid ? *in.p1 : in.ps;
@@ -152,7 +174,10 @@ CombinationResult combine(const CombinationInputs& in, const CombinationToleranc
 
   // Z: GP.z = P1.z, or the book-front plane from the cart model without P1.
   double gp_z;
-  if (r.p1_valid) {
+  if (hand) {
+    gp_z = in.hand_corner->z();
+    r.steps.push_back(step("GP.z", 0.0, 0.0, true, "GP.z = R's depth from the hand camera"));
+  } else if (r.p1_valid) {
     gp_z = in.p1->z();
     r.steps.push_back(step("GP.z", 0.0, 0.0, true, "GP.z = P1.z"));
   } else {

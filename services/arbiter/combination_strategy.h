@@ -28,6 +28,11 @@ struct CombinationTolerances {
   /// (flush, or pushed back with it by an earlier grasp's left plate), which the model's constant does not know.
   /// 0 = the paper (GP.z from the model whenever P1 is invalid).
   double invalid_p1_depth_range = 0.0;
+  /// Not in the paper: use the corner R triangulated by the servo (CombinationInputs::hand_corner) for GP.z and
+  /// P2.x when it lies within hand_corner_max_y_from_p2 of P2 in Y (it is the corner the servo centred) and within
+  /// invalid_p1_depth_range of the model's front plane (0 there: no depth check).
+  bool use_hand_corner = false;
+  double hand_corner_max_y_from_p2 = 0.01;
 };
 
 /// One decision of the strategy, with the numbers it was made on.
@@ -61,6 +66,10 @@ struct CombinationInputs {
   /// front when P1 lies on another book. Used without a valid P1 when within invalid_p1_depth_range of
   /// front_z_fallback.
   std::optional<double> stereo_front_z;
+  /// Not in the paper: R triangulated from the hand camera's views while the servo moved (grasp frame). Its Z is
+  /// the target front's depth measured at the book (BwS's P1.z is 1.5 m away and misses pushed-back books), and
+  /// its X is P2.x at that depth (the servo's converged pose assumed a depth).
+  std::optional<Eigen::Vector3d> hand_corner;
 };
 
 /// Result: GP (grasp frame) and every step.
@@ -88,7 +97,8 @@ std::optional<double> front_depth_without_p1(const CombinationInputs& in, const 
 CombinationResult validate_p1(const CombinationInputs& in, const CombinationTolerances& tol);
 
 /// The whole strategy: validate P1 against PS (3.1), then P2 against P1 (or PS
-/// when P1 is invalid) in Y and X (3.2), then GP = (P2.x, P2.y, P1.z).
+/// when P1 is invalid) in Y and X (3.2), then GP = (P2.x, P2.y, P1.z). With an accepted hand_corner
+/// (tol.use_hand_corner), P2.x and GP.z come from it.
 /// Inputs with NaN give kNoGrasp with a step naming the bad input.
 CombinationResult combine(const CombinationInputs& in, const CombinationTolerances& tol);
 

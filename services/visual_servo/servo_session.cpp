@@ -175,6 +175,7 @@ SessionOutput ServoSession::on_request(const ServoRequest& request) {
   arm_executing_seen_ = false;
   holding_ = false;
   last_lost_reason_.clear();
+  sightings_.clear();
   start_position_ = tcp_.translation();
   twist_.setZero();
   corner_.reset();
@@ -239,10 +240,23 @@ SessionOutput ServoSession::on_book(const BookObservation& obs) {
   slope_error_ = s.slope_error_rad;
   last_good_utime_ = now_;  // arrival (message time), see advance()
   holding_ = false;
+  const std::optional<Eigen::Isometry3d> at_capture = pose_at(obs.utime);
+  if (at_capture) sightings_.push_back({*at_capture * geo_.camera_in_gripper(), obs.r_px});
   if (s.converged) {
-    finish(ServoState::kConverged,
-           fmt("R within %.2f px of the target (%.1f, %.1f)", s.error_px.norm(), s.target_px.x(), s.target_px.y()),
-           &out, pose_at(obs.utime));
+    std::string why;
+    const std::optional<TriangulatedCorner> corner =
+        triangulate_corner(sightings_, geo_.intrinsics(), p_.corner_triangulation, &why);
+    std::string message =
+        fmt("R within %.2f px of the target (%.1f, %.1f)", s.error_px.norm(), s.target_px.x(), s.target_px.y());
+    if (corner) {
+      const Eigen::Vector3d in_tcp = at_capture ? at_capture->inverse() * corner->point : Eigen::Vector3d::Zero();
+      message += fmt("; R triangulated %.1f mm ahead of the TCP", in_tcp.z() * 1e3) +
+                 fmt(" from %.0f views over %.1f mm", corner->sightings, corner->baseline_m * 1e3);
+    } else {
+      message += "; R not triangulated: " + why;
+    }
+    finish(ServoState::kConverged, message, &out, at_capture);
+    if (!out.reports.empty()) out.reports.back().corner = corner;
     return out;
   }
   command(s.twist, &out);

@@ -25,6 +25,7 @@
 #include <Eigen/Geometry>
 
 #include "services/visual_servo/book_corner_servo.h"
+#include "services/visual_servo/corner_triangulation.h"
 #include "services/visual_servo/hand_eye_geometry.h"
 #include "services/visual_servo/stripe_end_servo.h"
 
@@ -56,6 +57,8 @@ struct ServoSessionParams {
   double default_corner_standoff_m = 0.2;  ///< TCP to book front when the request gives fixed_depth_m <= 0
   double default_stripe_standoff_m = 0.5;  ///< TCP to rear board when the request gives fixed_depth_m <= 0
   double pose_history_s = 1.0;             ///< end-effector poses kept to look up the pose at capture time
+  /// Not in the paper: R located in 3D from the corner servo's views at convergence (corner_triangulation.h).
+  CornerTriangulationParams corner_triangulation;
 };
 
 /// A start/cancel request (servo_request_t without LCM).
@@ -97,6 +100,9 @@ struct ServoReport {
   Eigen::Vector2d error_px = Eigen::Vector2d::Zero();
   double slope_error_rad = 0;
   std::optional<Eigen::Isometry3d> converged_pose;  ///< P2 or PS (CONVERGED only)
+  /// BOOK_CORNER CONVERGED only: R triangulated from the task's views, when they allowed it (else the
+  /// message says why not).
+  std::optional<TriangulatedCorner> corner;
   std::string message;
 };
 
@@ -175,6 +181,7 @@ class ServoSession {
   Eigen::Vector2d error_px_ = Eigen::Vector2d::Zero();
   double slope_error_ = 0;
   std::string last_lost_reason_;
+  std::vector<CornerSighting> sightings_;  ///< the corner task's views of R (camera pose at capture, pixel)
 };
 
 }  // namespace bookgrasp

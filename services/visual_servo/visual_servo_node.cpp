@@ -51,6 +51,12 @@ VisualServoSettings VisualServoSettings::from_config(const Config& root) {
   s.session.default_corner_standoff_m = se.get_double("default_corner_standoff_m", 0.01, 2);
   s.session.default_stripe_standoff_m = se.get_double("default_stripe_standoff_m", 0.01, 2);
   s.session.pose_history_s = se.get_double("pose_history_s", 0.05, 10);
+  {
+    const Config tr = root.child("corner_triangulation");
+    s.session.corner_triangulation.min_baseline_m = tr.get_double("min_baseline_m", 0.0, 1.0);
+    s.session.corner_triangulation.max_rms_px = tr.get_double("max_rms_px", 0.01, 1000);
+    s.session.corner_triangulation.min_sightings = tr.get_int("min_sightings", 2, 100000);
+  }
   if (s.session.stale_feature_s > s.session.feature_lost_timeout_s)
     throw ConfigError(se.path_of("stale_feature_s") + " must not exceed feature_lost_timeout_s");
 
@@ -126,6 +132,10 @@ void VisualServoNode::emit(const SessionOutput& out) {
     m.slope_error_rad = r.slope_error_rad;
     m.converged_pose = r.converged_pose ? isometry_to_pose(*r.converged_pose, "base", "gripper", r.utime)
                                         : isometry_to_pose(Eigen::Isometry3d::Identity(), "", "", r.utime);
+    m.corner_triangulated = r.corner.has_value();
+    for (int i = 0; i < 3; ++i) m.corner_base[i] = r.corner ? r.corner->point(i) : 0.0;
+    m.corner_baseline_m = r.corner ? r.corner->baseline_m : 0.0;
+    m.corner_rms_px = r.corner ? r.corner->rms_px : 0.0;
     m.message = r.message;
     publish(settings_.servo_status_channel, m);
   }

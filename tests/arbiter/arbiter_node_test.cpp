@@ -368,6 +368,25 @@ TEST_F(ArbiterNodeTest, AStereoFrontLeftOfPsGivesTheDepthWhenP1IsInvalid) {
   }
 }
 
+// Not in the paper: R triangulated by the corner servo gives GP.z and P2.x (arbiter.yaml hand_corner), here
+// over a valid P1 whose depth (0.01) is the unpushed front's while R stands 7 cm deeper.
+TEST_F(ArbiterNodeTest, TheServosTriangulatedCornerGivesGpZAndX) {
+  first_run({0.61, -0.30, 0.25}, {0.45, -0.305, 0.10});
+  send("SERVO_REQUEST", request(5000, 2, servo_request_t::BOOK_CORNER, 0));
+  servo_status_t st = status(6000, 2, servo_request_t::BOOK_CORNER, servo_status_t::CONVERGED, {0.45, -0.31, 0.24});
+  st.corner_triangulated = true;
+  st.corner_base[0] = 0.68;  // grasp (0.235, 0.262, 0.08)
+  st.corner_base[1] = -0.312;
+  st.corner_base[2] = 0.235;
+  send("SERVO_STATUS", st);
+  ASSERT_EQ(out.got.size(), 3u);
+  EXPECT_TRUE(starts_with(out.got[2].reason, "GRASP")) << out.got[2].reason;
+  expect_vec(out.got[2].gp_grasp, {0.235, 0.26, 0.08}, "GP = (R.x, P2.y, R.z)");
+  bool said = false;
+  for (const validation_step_t& v : out.got[2].steps) said |= v.decision.find("hand camera") != std::string::npos;
+  EXPECT_TRUE(said);
+}
+
 TEST_F(ArbiterNodeTest, ServoFailureIsNoGraspAndOpensANewAttempt) {
   first_run({0.61, -0.30, 0.25}, {0.45, -0.305, 0.10});
   send("SERVO_REQUEST", request(5000, 2, servo_request_t::BOOK_CORNER, 0));

@@ -204,6 +204,51 @@ TEST(CombinationStrategy, TheStereoFrontLeftOfPsComesBeforeAnInvalidP1sDepth) {
   EXPECT_EQ(outcome_name(combine(in, tol).outcome), outcome_name(GraspOutcome::kNoGrasp));
 }
 
+TEST(CombinationStrategy, TheHandCornerGivesGpZAndP2XBeforeEveryOtherDepth) {
+  CombinationTolerances tol;
+  CombinationInputs in = depth_case(&tol);
+  tol.use_hand_corner = true;
+  tol.hand_corner_max_y_from_p2 = 0.01;
+  in.p1 = V(0.10, 0.060, 0.43);  // invalid: 4 cm left of PS
+  in.stereo_front_z = 0.49;
+  // R triangulated 3 mm right of P2, 12 mm below it (the servo assumed a front too near), 9 cm deeper.
+  in.hand_corner = V(0.078, 0.098, 0.51);
+  CombinationResult r = combine(in, tol);
+  ASSERT_EQ(outcome_name(r.outcome), outcome_name(GraspOutcome::kGrasp));
+  EXPECT_TRUE(r.gp.isApprox(V(0.078, 0.095, 0.51), 1e-12)) << r.gp.transpose();  // Y stays P2's
+  EXPECT_NE(r.steps.back().decision.find("hand camera"), std::string::npos) << r.steps.back().decision;
+  // Also over a valid P1's depth (P1 at PS, 2 cm nearer than R), and P2.x at R's depth is checked against P1.x.
+  in.p1 = V(0.080, 0.097, 0.49);
+  r = combine(in, tol);
+  EXPECT_TRUE(r.p1_valid);
+  EXPECT_TRUE(r.gp.isApprox(V(0.078, 0.095, 0.51), 1e-12)) << r.gp.transpose();
+  // The paper's X rule still applies to the measured P2.x: 3 cm below P1, GP.x = P1.x.
+  in.hand_corner = V(0.050, 0.098, 0.51);
+  r = combine(in, tol);
+  EXPECT_TRUE(r.gp.isApprox(V(0.080, 0.095, 0.51), 1e-12)) << r.gp.transpose();
+  in.p1.reset();
+  // Refused, each with its reason, and the other depths take over (here the stereo front, 0.49):
+  struct Refusal {
+    Eigen::Vector3d corner;
+    const char* words;
+  };
+  for (const Refusal& c : {Refusal{V(0.078, 0.110, 0.51), "from P2 in Y"},       // 15 mm right of P2
+                           Refusal{V(0.078, 0.098, 0.60), "model's front plane"},  // 18 cm behind the model's front
+                           Refusal{V(NAN, 0.098, 0.51), "not finite"}}) {
+    in.hand_corner = c.corner;
+    r = combine(in, tol);
+    ASSERT_EQ(outcome_name(r.outcome), outcome_name(GraspOutcome::kGrasp)) << c.words;
+    EXPECT_TRUE(r.gp.isApprox(V(0.09, 0.095, 0.49), 1e-12)) << c.words << ": " << r.gp.transpose();
+    bool said = false;
+    for (const ValidationStep& st : r.steps) said |= st.decision.find(c.words) != std::string::npos;
+    EXPECT_TRUE(said) << c.words;
+  }
+  // Switched off (the paper): not used.
+  in.hand_corner = V(0.078, 0.098, 0.51);
+  tol.use_hand_corner = false;
+  EXPECT_TRUE(combine(in, tol).gp.isApprox(V(0.09, 0.095, 0.49), 1e-12));
+}
+
 TEST(CombinationStrategy, P1ValidityBoundaryAndTrace) {
   CombinationInputs in;
   in.ps = kPs;

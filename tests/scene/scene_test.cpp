@@ -263,11 +263,11 @@ TEST(Scene, ANegativeLedgeExtensionNamesTheKey) {
 
 TEST(Scene, BadGripperContactKeysAreNamed) {
   for (const auto& [from, to, key] : std::vector<std::array<std::string, 3>>{
-           {"finger_solref: [0.004, 1.0]", "finger_solref: [0.003, 1.0]", "physics.finger_solref"},
+           {"finger_solref: [0.01, 1.0]", "finger_solref: [0.003, 1.0]", "physics.finger_solref"},
            {"gripper_coupling_solref: [0.004, 1.0]", "gripper_coupling_solref: [0.004, 0.0]",
             "physics.gripper_coupling_solref"},
-           {"finger_solimp: [0.99, 0.999, 0.001]", "finger_solimp: [0.99, 0.9, 0.001]", "physics.finger_solimp"},
-           {"finger_solimp: [0.99, 0.999, 0.001]", "finger_solimp: [0.99, 0.999]", "finger_solimp"}}) {
+           {"finger_solimp: [0.95, 0.99, 0.001]", "finger_solimp: [0.95, 0.9, 0.001]", "physics.finger_solimp"},
+           {"finger_solimp: [0.95, 0.99, 0.001]", "finger_solimp: [0.95, 0.99]", "finger_solimp"}}) {
     std::string yaml = read_file(kScene);
     const auto pos = yaml.find(from);
     ASSERT_NE(pos, std::string::npos) << from;

@@ -318,8 +318,9 @@ TEST(StripeServoLatency, ImagesASecondLateStillConvergeOnTheTrueEnd) {
 }
 
 /// The corner servo with images `latency_s` late (run_with_late_images); the corner 4 cm up and 3 cm right of the
-/// start, its top edge rolled 3 degrees. Returns the final report.
-ServoReport run_late_corner(double latency_s, bool compensate) {
+/// start and `corner_z` ahead of it (the servo assumes 0.22 m), its top edge rolled 3 degrees. Returns the final
+/// report.
+ServoReport run_late_corner(double latency_s, bool compensate, double corner_z = 0.22) {
   const HandEyeGeometry geo = test::project_geometry();
   BookCornerServoParams cp;
   cp.gain = 2.0;
@@ -331,7 +332,7 @@ ServoReport run_late_corner(double latency_s, bool compensate) {
   cp.compensate_capture_delay = compensate;
   ServoSession session{geo, session_params(), cp, StripeEndServoParams{}};
   test::CornerScene scene;
-  scene.corner = Eigen::Vector3d(0.04, 0.03, 0.22);
+  scene.corner = Eigen::Vector3d(0.04, 0.03, corner_z);
   scene.roll_rad = 3.0 * M_PI / 180.0;
   ServoRequest r;
   r.utime = kT0;
@@ -360,6 +361,27 @@ TEST(CornerServoLatency, ImagesASecondLateStillConvergeOnTheTrueCorner) {
     EXPECT_NEAR(report.converged_pose->translation().y(), 0.03, 1.5e-3) << "latency " << latency;
   }
   EXPECT_NE(run_late_corner(1.0, false).state, ServoState::kConverged) << "the plant no longer shows the overshoot";
+}
+
+// Not in the paper: the converged report carries R located from the servo's views; it is right where the assumed
+// standoff is not (a front 6 cm deeper than assumed puts the converged TCP ~2 cm low, the camera being 6 cm above it).
+TEST(CornerServoTriangulation, TheConvergedReportLocatesRAtItsTrueDepth) {
+  for (const double corner_z : {0.22, 0.28, 0.16}) {
+    for (const double latency : {0.0, 0.7}) {
+      SCOPED_TRACE("corner z " + std::to_string(corner_z) + ", latency " + std::to_string(latency));
+      const ServoReport report = run_late_corner(latency, true, corner_z);
+      ASSERT_EQ(report.state, ServoState::kConverged) << report.message;
+      ASSERT_TRUE(report.corner.has_value()) << report.message;
+      EXPECT_LT((report.corner->point - Eigen::Vector3d(0.04, 0.03, corner_z)).norm(), 2e-3)
+          << report.corner->point.transpose();
+      EXPECT_GT(report.corner->baseline_m, 0.04);  // the servo moved 5 cm
+      EXPECT_LT(report.corner->rms_px, 0.5);
+      EXPECT_NE(report.message.find("R triangulated"), std::string::npos) << report.message;
+    }
+  }
+  // The assumed depth's error shows in the converged pose's X, not in the triangulated corner.
+  const ServoReport deep = run_late_corner(0.0, true, 0.28);
+  EXPECT_GT(std::abs(deep.converged_pose->translation().x() - 0.04), 0.01);
 }
 
 }  // namespace
