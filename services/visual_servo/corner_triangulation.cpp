@@ -41,15 +41,15 @@ double baseline_of(const std::vector<CornerSighting>& views) {
   double baseline = 0;
   for (size_t i = 0; i < views.size(); ++i)
     for (size_t j = i + 1; j < views.size(); ++j)
-      baseline = std::max(
-          baseline, (views[i].camera_in_base.translation() - views[j].camera_in_base.translation()).norm());
+      baseline =
+          std::max(baseline, (views[i].camera_in_base.translation() - views[j].camera_in_base.translation()).norm());
   return baseline;
 }
 }  // namespace
 
 std::optional<TriangulatedCorner> triangulate_corner(const std::vector<CornerSighting>& sightings,
-                                                     const CameraIntrinsics& k,
-                                                     const CornerTriangulationParams& params, std::string* why) {
+                                                     const CameraIntrinsics& k, const CornerTriangulationParams& params,
+                                                     std::string* why) {
   auto fail = [&](const std::string& reason) -> std::optional<TriangulatedCorner> {
     if (why) *why = reason;
     return std::nullopt;

@@ -232,7 +232,7 @@ TEST(CombinationStrategy, TheHandCornerGivesGpZAndP2XBeforeEveryOtherDepth) {
     Eigen::Vector3d corner;
     const char* words;
   };
-  for (const Refusal& c : {Refusal{V(0.078, 0.110, 0.51), "from P2 in Y"},       // 15 mm right of P2
+  for (const Refusal& c : {Refusal{V(0.078, 0.110, 0.51), "from P2 in Y"},         // 15 mm right of P2
                            Refusal{V(0.078, 0.098, 0.60), "model's front plane"},  // 18 cm behind the model's front
                            Refusal{V(NAN, 0.098, 0.51), "not finite"}}) {
     in.hand_corner = c.corner;

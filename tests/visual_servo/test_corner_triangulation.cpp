@@ -27,7 +27,8 @@ Eigen::Isometry3d camera_at(const Eigen::Vector3d& centre) {
   return c;
 }
 
-CornerSighting sight(const Eigen::Vector3d& point, const Eigen::Vector3d& centre, const Eigen::Vector2d& noise_px = Eigen::Vector2d::Zero()) {
+CornerSighting sight(const Eigen::Vector3d& point, const Eigen::Vector3d& centre,
+                     const Eigen::Vector2d& noise_px = Eigen::Vector2d::Zero()) {
   const CameraIntrinsics k = intrinsics();
   CornerSighting s;
   s.camera_in_base = camera_at(centre);
