@@ -51,6 +51,7 @@ CycleGeometry CycleGeometry::from_config(const Config& c) {
   g.holder_gripper_axes.col(2) = x.cross(y);
   g.holder_pre_place_offset = vec3(c, "holder.pre_place_offset_m", 1.0);
   g.holder_place_descent = c.get_double("holder.place_descent_m", 0.0, 0.5);
+  g.holder_place_guard = c.get_double("holder.place_guard_m", 0.0, 0.1);
   g.holder_retreat = c.get_double("holder.retreat_m", 0.02, 0.6);
   g.holder_regrasp_lower = c.get_double("holder.regrasp_lower_m", 0.0, 0.03);
   g.lower_drop = c.get_double("lower_shelf.drop_m", 0.1, 1.5);
@@ -63,6 +64,7 @@ CycleGeometry CycleGeometry::from_config(const Config& c) {
                       c.path_of("lower_shelf.left_y_m"));
   g.lower_pre_place_offset = vec3(c, "lower_shelf.pre_place_offset_m", 1.0);
   g.lower_retreat = c.get_double("lower_shelf.retreat_m", 0.02, 1.0);
+  g.lower_place_guard = c.get_double("lower_shelf.place_guard_m", 0.0, 0.1);
   g.lower_shelf_gap = c.get_double("lower_shelf.gap_to_upper_shelf_m", 0.0, 1.5);
   g.held_top_above_tcp = c.get_double("lower_shelf.held_box_top_above_tcp_m", -0.2, 0.2);
   g.place_clearance = c.get_double("place_clearance_m", 0.0, 0.05);

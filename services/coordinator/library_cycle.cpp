@@ -179,6 +179,8 @@ CycleSettings CycleSettings::from_config(const Config& root) {
   s.linear_gain = a.get_double("linear_gain", 0.1, 20);
   s.linear_position_tolerance = a.get_double("linear_position_tolerance_m", 1e-5, 0.02);
   s.linear_orientation_tolerance = a.get_double("linear_orientation_tolerance_rad", 1e-5, 0.2);
+  s.stall_s = a.get_double("stall_s", 0.05, 10);
+  s.stall_distance = a.get_double("stall_distance_m", 1e-5, 0.05);
   const Config g = root.child("gripper");
   s.gripper_open_width = g.get_double("open_width_m", 0.005, 0.2);
   s.gripper_open_tolerance = g.get_double("open_tolerance_m", 1e-5, 0.02);
@@ -330,10 +332,11 @@ void LibraryCycle::issue_plan() {
   out_.push_back(r);
 }
 
-void LibraryCycle::start_linear(std::vector<Eigen::Isometry3d> waypoints) {
+void LibraryCycle::start_linear(std::vector<Eigen::Isometry3d> waypoints, double guard) {
   motion_ = Motion{};
   motion_.kind = MotionKind::kLinear;
   motion_.waypoints = std::move(waypoints);
+  motion_.guard = guard;
   motion_.command_id = next_id();
   double length = 0;
   Eigen::Vector3d from = arm_ ? arm_->end_effector.translation() : motion_.waypoints.front().translation();
@@ -401,6 +404,23 @@ void LibraryCycle::drive_motion(const ArmEvent& e) {
           motion_done();
         }
         return;
+      }
+      // A guarded place: the book met its support before the TCP reached the pose (it slid down in the plates).
+      if (motion_.guard > 0 && motion_.executing && motion_.waypoint + 1 == motion_.waypoints.size() &&
+          ep.norm() < motion_.guard) {
+        const Eigen::Vector3d at = e.end_effector.translation();
+        if (motion_.stall_since < 0 || (at - motion_.stall_from).norm() > s_.stall_distance) {
+          motion_.stall_from = at;
+          motion_.stall_since = now_;
+        } else if (static_cast<double>(now_ - motion_.stall_since) >= s_.stall_s * 1e6) {
+          char buf[160];
+          std::snprintf(buf, sizeof buf, "the book met its support %.1f mm before the place pose (slid down in the "
+                        "plates): placed there", ep.norm() * 1e3);
+          message_ = buf;
+          out_.push_back(make_request(CycleRequest::Kind::kArmStop));
+          motion_done();
+          return;
+        }
       }
       if (motion_.executing && static_cast<double>(now_ - last_command_utime_) < s_.heartbeat_period_s * 1e6) return;
       Eigen::Vector3d v = s_.linear_gain * ep;
@@ -700,7 +720,7 @@ void LibraryCycle::enter(CycleState s) {
       start_planned_pose(holder_pre_place_pose(holder_frame(), tcp_height(), g), true);
       break;
     case CycleState::kPlaceOnHolder:
-      start_linear(holder_place_moves(holder_frame(), tcp_height(), g));
+      start_linear(holder_place_moves(holder_frame(), tcp_height(), g), g.holder_place_guard);
       break;
     case CycleState::kApproachHolder:
       start_linear({holder_place_pose(holder_frame(), holder_regrasp_height(tcp_height(), g), g)});
@@ -738,7 +758,8 @@ void LibraryCycle::enter(CycleState s) {
     }
     case CycleState::kPlaceOnLowerShelf:
       start_linear({lower_place_pose(cart_frame(), progress_.lower_next_right_y, progress_.book_width,
-                                     height_held_from_holder(tcp_height(), g), g)});
+                                     height_held_from_holder(tcp_height(), g), g)},
+                   g.lower_place_guard);
       break;
     case CycleState::kRetreatFromLowerShelf:
       start_linear({move_along_own_axes(arm_->end_effector, Eigen::Vector3d(0, 0, -g.lower_retreat))});

@@ -69,6 +69,8 @@ struct CycleSettings {
   double linear_gain = 2.0;               ///< 1/s, proportional gain of straight moves
   double linear_position_tolerance = 0.001;
   double linear_orientation_tolerance = 0.01;
+  double stall_s = 1.0;           ///< a guarded place's TCP moving less than stall_distance for this long has stalled
+  double stall_distance = 0.001;  ///< metres
   // gripper
   double gripper_open_width = 0.06;
   double gripper_open_tolerance = 0.002;
@@ -272,6 +274,9 @@ class LibraryCycle {
     bool executing = false;
     std::vector<Eigen::Isometry3d> waypoints;
     size_t waypoint = 0;
+    double guard = 0;                    ///< last waypoint: a stall within this of it ends the move (a place)
+    Eigen::Vector3d stall_from = Eigen::Vector3d::Zero();
+    int64_t stall_since = -1;
     int64_t settle_start = -1;
     double settle_width = 0;
   };
@@ -285,7 +290,8 @@ class LibraryCycle {
   void set_deadline(double seconds);
   void start_planned_joints(const std::vector<double>& goal);
   void start_planned_pose(const Eigen::Isometry3d& goal, bool holding);
-  void start_linear(std::vector<Eigen::Isometry3d> waypoints);
+  /// Straight moves through `waypoints`; `guard` > 0: the arm stalling within it of the last one ends the move.
+  void start_linear(std::vector<Eigen::Isometry3d> waypoints, double guard = 0);
   void start_gripper(bool grasp);
   void issue_plan();
   void drive_motion(const ArmEvent& e);

@@ -2,20 +2,14 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <string>
 
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
 
+#include "common/text_format.h"
+
 namespace bookgrasp {
-namespace {
-std::string fmt(const char* f, double a, double b) {
-  char buf[200];
-  std::snprintf(buf, sizeof(buf), f, a, b);
-  return buf;
-}
-}  // namespace
 
 namespace {
 /// The least-squares point of the rays of `views`; false if they are (nearly) parallel.
@@ -56,9 +50,9 @@ std::optional<TriangulatedCorner> triangulate_corner(const std::vector<CornerSig
   };
   const int need = std::max(2, params.min_sightings);
   if (static_cast<int>(sightings.size()) < need)
-    return fail(fmt("%.0f sightings of R, need %.0f", sightings.size(), need));
+    return fail(format_text("%zu sightings of R, need %d", sightings.size(), need));
   if (baseline_of(sightings) < params.min_baseline_m)
-    return fail(fmt("the camera moved %.1f mm while seeing R, need %.1f mm", baseline_of(sightings) * 1e3,
+    return fail(format_text("the camera moved %.1f mm while seeing R, need %.1f mm", baseline_of(sightings) * 1e3,
                     params.min_baseline_m * 1e3));
   // Views whose R was another point (the detector took a shadow edge or another book for the corner on the
   // way) are dropped one at a time, the worst first, while enough views over enough baseline remain.
@@ -82,8 +76,8 @@ std::optional<TriangulatedCorner> triangulate_corner(const std::vector<CornerSig
     std::vector<CornerSighting> fewer = views;
     fewer.erase(fewer.begin() + (std::max_element(err.begin(), err.end()) - err.begin()));
     if (static_cast<int>(fewer.size()) < need || baseline_of(fewer) < params.min_baseline_m)
-      return fail(fmt("R does not stay one point: reprojection RMS %.2f px > %.2f px", out.rms_px, params.max_rms_px) +
-                  fmt(" over the %.0f views left", views.size(), 0));
+      return fail(format_text("R does not stay one point: reprojection RMS %.2f px > %.2f px over the %zu views left",
+                              out.rms_px, params.max_rms_px, views.size()));
     views = std::move(fewer);
   }
 }

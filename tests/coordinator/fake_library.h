@@ -81,6 +81,9 @@ class FakeLibrary {
   bool user_answers = true;                  ///< sends "done" in WAIT_USER after 1 s
   int arm_moves_during_planning = 0;         ///< the next N plans: the joints move 0.05 rad before the answer
   int coast_after_servo_ticks = 0;           ///< after each servo answer the arm still EXECUTES this many ticks
+  /// State name -> base z the TCP cannot go below in that state's straight moves (the held book stands on its
+  /// support early: it slid down in the plates)
+  std::map<std::string, double> floor_z;
 
   // ---- world ----
   std::deque<FakeBook> upper;
@@ -107,6 +110,7 @@ class FakeLibrary {
   /// Advances 10 ms: an arm state (and markers every 100 ms) to `cycle`, answering its requests.
   void tick(LibraryCycle& cycle) {
     t += 10000;
+    state_now_ = bookgrasp::cycle_state_name(cycle.state());
     integrate();
     tcp_path.emplace_back(bookgrasp::cycle_state_name(cycle.state()), ee.translation());
     if ((t / 10000) % 10 == 0 || !markers_sent_) {
@@ -156,6 +160,7 @@ class FakeLibrary {
   }
 
  private:
+  std::string state_now_;  ///< the cycle's state at this tick
   struct Plan {
     bool joints = false;
     Eigen::Isometry3d goal;
@@ -179,6 +184,8 @@ class FakeLibrary {
     if (arm_state == 1 && !executing_plan_) {
       const double dt = 0.01;
       ee.translation() += twist_.head<3>() * dt;
+      if (const auto f = floor_z.find(state_now_); f != floor_z.end())
+        ee.translation().z() = std::max(ee.translation().z(), f->second);
       const Eigen::Vector3d w = twist_.tail<3>();
       if (w.norm() > 1e-12) ee.linear() = Eigen::AngleAxisd(w.norm() * dt, w.normalized()).toRotationMatrix() * ee.linear();
     }

@@ -339,6 +339,45 @@ TEST(LibraryCycle, StepFailuresWithABookHeldAbortKeepingTheBook) {
   EXPECT_NE(w.requests.back().kind, CycleRequest::Kind::kGripperMove);
 }
 
+// A book that slid down in the plates on the way meets the holder's ledge (or the lower shelf) before the TCP
+// reaches the place pose: the arm stalls there, and the place is done (holder.place_guard_m,
+// lower_shelf.place_guard_m); without the guard every try times out and the task aborts with the book held.
+TEST(LibraryCycle, APlaceThatStallsOnItsSupportWithinTheGuardIsDone) {
+  // Where the TCP releases the first book on the holder and on the lower shelf when nothing is in the way.
+  FakeLibrary free_world(three_books());
+  {
+    LibraryCycle cycle(settings(), std::nullopt);
+    free_world.run(cycle, [&] { return cycle.progress().books_moved >= 1 || done_or_aborted(cycle); });
+    ASSERT_EQ(free_world.holder_drops.size(), 1u);
+    ASSERT_EQ(free_world.lower.size(), 1u);
+  }
+  const double holder_z = free_world.holder_drops[0].second.translation().z();
+  const double lower_z = free_world.lower[0].second.translation().z();
+  for (const double guard : {0.03, 0.0}) {
+    SCOPED_TRACE("guard " + std::to_string(guard));
+    FakeLibrary w(three_books());
+    w.floor_z["PLACE_ON_HOLDER"] = holder_z + 0.012;  // the book slid 12 mm down
+    w.floor_z["PLACE_ON_LOWER_SHELF"] = lower_z + 0.012;
+    CycleSettings s = settings();
+    s.geometry.holder_place_guard = guard;
+    s.geometry.lower_place_guard = guard;
+    LibraryCycle cycle(s, std::nullopt);
+    w.run(cycle, [&] { return cycle.progress().books_moved >= 1 || done_or_aborted(cycle); });
+    if (guard > 0) {
+      EXPECT_EQ(cycle.progress().books_moved, 1) << cycle.status().message;
+      EXPECT_EQ(cycle.progress().failures, 0);
+      ASSERT_EQ(w.holder_drops.size(), 1u);
+      EXPECT_NEAR(w.holder_drops[0].second.translation().z(), holder_z + 0.012, 1e-3);
+      ASSERT_EQ(w.lower.size(), 1u);
+      EXPECT_NEAR(w.lower[0].second.translation().z(), lower_z + 0.012, 1e-3);
+    } else {
+      EXPECT_EQ(cycle.state(), CycleState::kAborted);
+      EXPECT_NE(cycle.status().message.find("timeout in PLACE_ON_HOLDER"), std::string::npos) << cycle.status().message;
+      EXPECT_TRUE(w.in_gripper.has_value());
+    }
+  }
+}
+
 TEST(LibraryCycle, ServoTimeoutInMessageTimeIsAFailure) {
   FakeLibrary w(three_books());
   w.servo_silent = true;

@@ -357,7 +357,7 @@ TEST_P(ScriptedGrasp, EachPlatePressesWithTheCommandedForce) {
       (book().width_m - width1) * 1e3);
   for (double f : {l0, r0, l1, r1}) EXPECT_NEAR(f, kForce, 0.1 * kForce);
   // The plates sink ~0.45 mm each into the covers at 60 N (physics.finger_solref/solimp; MuJoCo's defaults: 0.65).
-  // At the grasp the book still stands on the shelf between its neighbours (seed 4: 1.85 mm under there, 0.93 mm
+  // At the grasp the book still stands on the shelf between its neighbours (seeds 1 and 4: 1.9 mm under there, 0.9 mm
   // once hanging in the plates).
   EXPECT_NEAR(width0, book().width_m, 0.002);
   EXPECT_NEAR(width1, book().width_m, 0.001);
