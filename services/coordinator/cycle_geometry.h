@@ -51,7 +51,7 @@ struct CycleGeometry {
   /// The place on the holder counts as done when the arm stalls within this of the place pose: the book stands on
   /// the ledge, lower in the plates than its grasp put it (it slid down on the way; 0 = the pose must be reached).
   double holder_place_guard = 0.0;
-  double lower_place_guard = 0.0;  ///< the same for the place on the lower shelf
+  double lower_place_guard = 0.0;   ///< the same for the place on the lower shelf
   double holder_retreat = 0.10;     ///< after release, out along the gripper -z
   double holder_regrasp_lower = 0.0;  ///< the grasp from the holder puts the TCP this much lower on the book
   // lower shelf

@@ -274,7 +274,7 @@ class LibraryCycle {
     bool executing = false;
     std::vector<Eigen::Isometry3d> waypoints;
     size_t waypoint = 0;
-    double guard = 0;                    ///< last waypoint: a stall within this of it ends the move (a place)
+    double guard = 0;  ///< last waypoint: a stall within this of it ends the move (a place)
     Eigen::Vector3d stall_from = Eigen::Vector3d::Zero();
     int64_t stall_since = -1;
     int64_t settle_start = -1;

@@ -53,7 +53,7 @@ std::optional<TriangulatedCorner> triangulate_corner(const std::vector<CornerSig
     return fail(format_text("%zu sightings of R, need %d", sightings.size(), need));
   if (baseline_of(sightings) < params.min_baseline_m)
     return fail(format_text("the camera moved %.1f mm while seeing R, need %.1f mm", baseline_of(sightings) * 1e3,
-                    params.min_baseline_m * 1e3));
+                            params.min_baseline_m * 1e3));
   // Views whose R was another point (the detector took a shadow edge or another book for the corner on the
   // way) are dropped one at a time, the worst first, while enough views over enough baseline remain.
   std::vector<CornerSighting> views = sightings;
