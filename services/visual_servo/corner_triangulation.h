@@ -24,7 +24,7 @@ struct CornerSighting {
 /// Acceptance limits of a triangulation (from configuration).
 struct CornerTriangulationParams {
   double min_baseline_m = 0.015;  ///< camera centres must span at least this (the depth's error grows as 1/baseline)
-  double max_rms_px = 2.0;        ///< reprojection RMS of the point over the sightings at most this
+  double max_rms_px = 2.0;        ///< RMS error of the agreeing views at most this (pixels)
   int min_sightings = 4;          ///< at least this many views
 };
 
@@ -32,15 +32,16 @@ struct CornerTriangulationParams {
 struct TriangulatedCorner {
   Eigen::Vector3d point = Eigen::Vector3d::Zero();  ///< in `base`
   double baseline_m = 0;                            ///< largest distance between two camera centres
-  double rms_px = 0;                                ///< reprojection RMS over the sightings
+  double rms_px = 0;                                ///< RMS of the views' errors (pixels)
   int sightings = 0;                                ///< views used
 };
 
-/// The point nearest to the sightings' viewing rays. While its reprojection RMS exceeds max_rms_px, the view
-/// farthest from it is dropped (R detected on another edge on the way) and the point solved again. Returns
+/// The point nearest to the viewing rays of the largest set of sightings that agree (each within 2 x max_rms_px
+/// of the point of some pair of them: R detected on another edge on the way is left out). A view's error is the
+/// angle between its ray and the direction to the point, times fx (the reprojection error for small angles). Returns
 /// nothing, with `why` set, when there are fewer than min_sightings views, their centres span less than
-/// min_baseline_m, the rays are (nearly) parallel, the point lies behind a camera, or no subset of at least
-/// min_sightings views over min_baseline_m reprojects within max_rms_px (R was not one fixed point).
+/// min_baseline_m, the rays are (nearly) parallel, the point lies behind a camera, or the agreeing views are fewer than
+/// min_sightings, span less than min_baseline_m or have an RMS error above max_rms_px (R was not one fixed point).
 std::optional<TriangulatedCorner> triangulate_corner(const std::vector<CornerSighting>& sightings,
                                                      const CameraIntrinsics& intrinsics,
                                                      const CornerTriangulationParams& params, std::string* why);

@@ -58,6 +58,12 @@ TEST(CornerTriangulation, ExactRaysGiveThePoint) {
   EXPECT_NEAR(t->baseline_m, 0.03, 1e-12);
   EXPECT_EQ(t->sightings, 10);
   EXPECT_LT(t->rms_px, 1e-6);
+  // A long servo's 200 views: 40 of them, evenly spread, still over the whole baseline.
+  const auto many = triangulate_corner(upward_views(0.03, 200), intrinsics(), CornerTriangulationParams{}, &why);
+  ASSERT_TRUE(many.has_value()) << why;
+  EXPECT_EQ(many->sightings, 40);
+  EXPECT_NEAR(many->baseline_m, 0.03, 1e-12);
+  EXPECT_LT((many->point - kCorner).norm(), 1e-9);
 }
 
 TEST(CornerTriangulation, HalfAPixelOfNoiseOverThreeCentimetresStaysWithinAFewMillimetres) {
@@ -81,6 +87,13 @@ TEST(CornerTriangulation, AViewOfAnotherPointIsDropped) {
   ASSERT_TRUE(t.has_value()) << why;
   EXPECT_EQ(t->sightings, 8);
   EXPECT_LT((t->point - kCorner).norm(), 1e-9);
+  // Early views of a point far off put the least-squares point behind them: they are dropped too.
+  std::vector<CornerSighting> far_off = upward_views(0.06, 12);
+  for (int i = 0; i < 3; ++i) far_off[i].pixel = Eigen::Vector2d(20.0 + 10 * i, 470.0);
+  const auto u = triangulate_corner(far_off, intrinsics(), CornerTriangulationParams{}, &why);
+  ASSERT_TRUE(u.has_value()) << why;
+  EXPECT_EQ(u->sightings, 9);
+  EXPECT_LT((u->point - kCorner).norm(), 1e-9);
 }
 
 TEST(CornerTriangulation, RefusesWithAReason) {
@@ -92,11 +105,11 @@ TEST(CornerTriangulation, RefusesWithAReason) {
   };
   refused(upward_views(0.03, 3), "3 sightings of R, need 4");
   refused(upward_views(0.01, 10), "moved 10.0 mm while seeing R, need 15.0 mm");
-  // Half the views see another point 3 cm lower (two edges taken for R in turn): no subset over 15 mm is one point.
+  // Half the views see another point 3 cm lower (two edges taken for R in turn): each half alone spans too little.
   std::vector<CornerSighting> two = upward_views(0.03, 10);
   for (int i = 5; i < 10; ++i)
     two[i] = sight(kCorner - Eigen::Vector3d(0, 0, 0.03), two[i].camera_in_base.translation());
-  refused(two, "R does not stay one point");
+  refused(two, "the 5 views of R that agree span 13.3 mm, need 15.0 mm");
   // Every ray points the same way from centres along it: parallel.
   std::vector<CornerSighting> parallel;
   for (int i = 0; i < 5; ++i) parallel.push_back(sight(kCorner, Eigen::Vector3d(0.30 + 0.01 * i, -0.15, 0.42)));
@@ -108,7 +121,7 @@ TEST(CornerTriangulation, RefusesWithAReason) {
     s.camera_in_base.linear() = s.camera_in_base.linear() * Eigen::Vector3d(-1, 1, -1).asDiagonal();
     s.pixel.y() = 2 * intrinsics().cy - s.pixel.y();
   }
-  refused(behind, "behind");
+  refused(behind, "behind the cameras");
 }
 
 }  // namespace
