@@ -413,12 +413,9 @@ void LibraryCycle::drive_motion(const ArmEvent& e) {
           motion_.stall_from = at;
           motion_.stall_since = now_;
         } else if (static_cast<double>(now_ - motion_.stall_since) >= s_.stall_s * 1e6) {
-          char buf[160];
-          std::snprintf(buf, sizeof buf,
-                        "the book met its support %.1f mm before the place pose (slid down in the "
-                        "plates): placed there",
-                        ep.norm() * 1e3);
-          message_ = buf;
+          message_ = "the book met its support " + mm(ep.norm()) +
+                     " before the place pose (slid down in the plates): "
+                     "placed there";
           out_.push_back(make_request(CycleRequest::Kind::kArmStop));
           motion_done();
           return;
