@@ -40,6 +40,7 @@ CycleGeometry CycleGeometry::from_config(const Config& c) {
   g.deep_front_z = c.get_double("grasp.deep_front_z_m", -0.2, 0.36);
   g.extract_lift = c.get_double("grasp.extract_lift_m", 0.0, 0.5);
   g.extract_retreat = c.get_double("grasp.extract_retreat_m", 0.0, 1.0);
+  g.extract_lift_out = c.get_double("grasp.extract_lift_out_m", 0.0, 0.3);
   g.holder_support_in_marker = vec3(c, "holder.support_origin_in_marker_m");
   g.holder_place_tcp = vec3(c, "holder.place_tcp_in_support_m");
   const Eigen::Vector3d x = vec3(c, "holder.gripper_x_in_support"), y = vec3(c, "holder.gripper_y_in_support");
@@ -113,8 +114,11 @@ std::vector<Eigen::Isometry3d> extract_moves(const Eigen::Isometry3d& here, cons
   const auto along = [&](const Eigen::Isometry3d& pose, int axis) {
     return std::max(0.5, std::abs((to_grasp.linear() * pose.linear().col(axis))(axis)));
   };
-  const double up = tcp_height + g.extract_lift - (to_grasp * here.translation()).x();
-  const Eigen::Isometry3d lifted = move_along_own_axes(here, Eigen::Vector3d(std::max(0.0, up) / along(here, 0), 0, 0));
+  const Eigen::Vector3d at = to_grasp * here.translation();
+  const double up = std::max(0.0, tcp_height + g.extract_lift - at.x());
+  const double lift_out = std::max(0.0, at.z() - (grasp_tcp_z - g.extract_lift_out));
+  const Eigen::Isometry3d lifted =
+      move_along_own_axes(here, Eigen::Vector3d(up / along(here, 0), 0, -lift_out / along(here, 2)));
   const double out = (to_grasp * lifted.translation()).z() - (grasp_tcp_z - g.extract_retreat);
   return {lifted, move_along_own_axes(lifted, Eigen::Vector3d(0, 0, -std::max(0.0, out) / along(lifted, 2)))};
 }

@@ -41,6 +41,10 @@ struct CycleGeometry {
   /// depth would get: the plates in front of the planner's books box, the held book's box off the rear board.
   double deep_front_z = 0.035;
   double extract_lift = 0.01;       ///< first lift along the gripper x after the grasp
+  /// The lift also moves the TCP this far towards the robot (along the gripper -z): a diagonal lift whose end
+  /// brings the wrist nearer the shoulder (the stretched arm reaches the straight lift's end for no book at the
+  /// shelf's right end; bookgrasp_cycle_reach). 0 = straight up.
+  double extract_lift_out = 0.0;
   double extract_retreat = 0.40;    ///< then straight out along the gripper -z
   // holder
   Eigen::Vector3d holder_support_in_marker = Eigen::Vector3d::Zero();  ///< support origin, holder marker axes
@@ -125,8 +129,9 @@ Eigen::Isometry3d lower_pre_place_pose(const Eigen::Isometry3d& grasp_frame, dou
 /// grasp Z `front_z`, the TCP held at `bwh_start_z`; at least 2 cm.
 double servo_standoff(double front_z, const CycleGeometry& g);
 /// The two straight moves of EXTRACT from the TCP pose `here`: up along the gripper's own x until the TCP is
-/// `extract_lift` above `tcp_height` (its height on the book, grasp X), then out along its own -z until it is
-/// `extract_retreat` in front of `grasp_tcp_z` (the TCP's grasp Z at the grasp). The targets are absolute in the
+/// `extract_lift` above `tcp_height` (its height on the book, grasp X) while out along its own -z until it is
+/// `extract_lift_out` in front of `grasp_tcp_z` (the TCP's grasp Z at the grasp): one diagonal line; then out
+/// along its own -z until it is `extract_retreat` in front of `grasp_tcp_z`. The targets are absolute in the
 /// grasp frame `grasp_frame`, so an EXTRACT resumed or retried part-way ends where the first would have (a lift
 /// relative to `here` took a resumed coordinator's arm 0.34 m beyond it, into a joint limit). Neither move goes
 /// back: a TCP already higher or further out stays there.

@@ -60,9 +60,10 @@ std::vector<StageReach> cycle_reach(const scene::Scene& scene, const CycleGeomet
   poses.emplace_back("pre_grasp", pre_grasp_pose(gp, p1.z(), g));
   const Eigen::Isometry3d gr = grasp_pose(gp, g);
   poses.emplace_back("grasp", gr);
-  poses.emplace_back("extract_lift", move_along_own_axes(gr, Eigen::Vector3d(g.extract_lift, 0, 0)));
-  poses.emplace_back("extract_end", move_along_own_axes(gr, Eigen::Vector3d(g.extract_lift, 0, -g.extract_retreat)));
   const double h = tcp_height_on_book(p1, g);
+  const auto extract = extract_moves(gr, grasp, h, moves_front_z(p1.z(), g) + g.insertion_depth, g);
+  poses.emplace_back("extract_lift", extract[0]);
+  poses.emplace_back("extract_end", extract[1]);
   const Eigen::Isometry3d& support = scene.holder_support_pose;
   poses.emplace_back("holder_pre_place", holder_pre_place_pose(support, h, g));
   const Eigen::Isometry3d hp = holder_place_pose(support, h, g);

@@ -126,5 +126,36 @@ TEST(CycleGeometry, ExtractEndsAtTheSameHeightAndDepthWhereverItStarts) {
   EXPECT_NEAR((f.inverse() * extract_moves(tilted, f, tcp_height, grasp_z, g)[0].translation()).x(), 0.54, 1e-12);
 }
 
+TEST(CycleGeometry, ADiagonalLiftEndsOutAndUpInOneLineAndTheRetreatStaysWithin) {
+  CycleGeometry g = geometry();
+  g.extract_lift = 0.34;
+  g.extract_lift_out = 0.10;
+  g.extract_retreat = 0.02;
+  Eigen::Isometry3d f = Eigen::Isometry3d::Identity();
+  f.linear() = grasp_axes();
+  f.translation() = Eigen::Vector3d(0.8, -0.05, 0.0);
+  const double tcp_height = 0.25, grasp_z = 0.05;
+  Eigen::Isometry3d at_grasp = f;
+  at_grasp.translation() = f * Eigen::Vector3d(tcp_height, -0.3, grasp_z);
+  const auto moves = extract_moves(at_grasp, f, tcp_height, grasp_z, g);
+  ASSERT_EQ(moves.size(), 2u);
+  const Eigen::Vector3d lifted = f.inverse() * moves[0].translation(), end = f.inverse() * moves[1].translation();
+  EXPECT_NEAR(lifted.x(), 0.59, 1e-12);   // 0.25 + 0.34
+  EXPECT_NEAR(lifted.y(), -0.3, 1e-12);   // never sideways
+  EXPECT_NEAR(lifted.z(), -0.05, 1e-12);  // 0.10 out of 0.05
+  // The retreat (2 cm) is within the diagonal's 10 cm: it goes nowhere.
+  EXPECT_TRUE(end.isApprox(lifted, 1e-12));
+  EXPECT_TRUE(moves[0].linear().isApprox(at_grasp.linear(), 1e-12));  // the orientation is kept
+  // Resumed half-way along the diagonal: the same end.
+  Eigen::Isometry3d half = at_grasp;
+  half.translation() = f * Eigen::Vector3d(0.42, -0.3, 0.0);
+  EXPECT_TRUE(extract_moves(half, f, tcp_height, grasp_z, g)[0].translation().isApprox(moves[0].translation(), 1e-12));
+  // A retreat longer than the diagonal's way out goes on from the lift's end.
+  g.extract_retreat = 0.15;
+  const Eigen::Vector3d further = f.inverse() * extract_moves(at_grasp, f, tcp_height, grasp_z, g)[1].translation();
+  EXPECT_NEAR(further.x(), 0.59, 1e-12);
+  EXPECT_NEAR(further.z(), -0.10, 1e-12);
+}
+
 }  // namespace
 }  // namespace bookgrasp

@@ -97,6 +97,35 @@ TEST(CycleReach, StagesAgreeWithForwardKinematicsAndTheElbowLimit) {
   EXPECT_GT(reachable, 0) << "no stage of " << stages << " reachable: the check itself is suspect";
 }
 
+// The extraction at the shelf's right end (far_cart seeds 13, 14, 22: books 0.39-0.40 m right of the
+// shoulder): straight up, the stretched arm does not reach the lift's end; the shipped diagonal lift
+// (geometry.grasp.extract_lift_out_m) reaches it and the end of the extraction.
+TEST(CycleReach, TheDiagonalLiftReachesTheRightEndsBooksTheStraightLiftDoesNot) {
+  const ArmKinematics kin = arm();
+  IkParams p;
+  p.max_restarts = 24;
+  const InverseKinematics ik(kin, p);
+  Eigen::VectorXd park(7);
+  park << 0, -M_PI / 2, 0, -M_PI / 2, 0, -M_PI / 2, 0;
+  const CycleGeometry shipped = coordinator_geometry();
+  ASSERT_GT(shipped.extract_lift_out, 0.0);
+  CycleGeometry straight = shipped;
+  straight.extract_lift_out = 0.0;
+  const auto reach = [&](const std::vector<StageReach>& r, const std::string& stage) {
+    for (const StageReach& st : r)
+      if (st.stage == stage) return st.reachable;
+    ADD_FAILURE() << "no stage " << stage;
+    return false;
+  };
+  for (uint64_t seed : {13, 14, 22}) {
+    const scene::Scene scene = scene::load_scene(kSrc + "/config/scenes/far_cart.yaml", seed);
+    EXPECT_FALSE(reach(cycle_reach(scene, straight, ik, park), "extract_lift")) << "seed " << seed;
+    const std::vector<StageReach> r = cycle_reach(scene, shipped, ik, park);
+    EXPECT_TRUE(reach(r, "extract_lift")) << "seed " << seed;
+    EXPECT_TRUE(reach(r, "extract_end")) << "seed " << seed;
+  }
+}
+
 TEST(CycleReach, SceneWithoutBooksIsAClearError) {
   scene::Scene scene = scene::load_scene(kSrc + "/config/scenes/default.yaml", 1);
   scene.books.clear();
