@@ -181,6 +181,7 @@ CycleSettings CycleSettings::from_config(const Config& root) {
   s.linear_orientation_tolerance = a.get_double("linear_orientation_tolerance_rad", 1e-5, 0.2);
   s.stall_s = a.get_double("stall_s", 0.05, 10);
   s.stall_distance = a.get_double("stall_distance_m", 1e-5, 0.05);
+  s.limit_stop_place = a.get_double("limit_stop_place_m", 0.0, 0.05);
   const Config g = root.child("gripper");
   s.gripper_open_width = g.get_double("open_width_m", 0.005, 0.2);
   s.gripper_open_tolerance = g.get_double("open_tolerance_m", 1e-5, 0.02);
@@ -390,13 +391,20 @@ void LibraryCycle::drive_motion(const ArmEvent& e) {
       return;
     }
     case MotionKind::kLinear: {
+      const Eigen::Isometry3d& target = motion_.waypoints[motion_.waypoint];
+      const Eigen::Vector3d ep = target.translation() - e.end_effector.translation();
       if (e.active_command_id == motion_.command_id && (e.state == kArmStopped || e.state == kArmFault) &&
           motion_.executing) {
+        // A guarded place stopped by the driver (a joint limit) right above the place pose: the book is there.
+        if (e.state == kArmStopped && motion_.guard > 0 && motion_.waypoint + 1 == motion_.waypoints.size() &&
+            ep.norm() < s_.limit_stop_place) {
+          message_ = "the arm stopped " + mm(ep.norm()) + " before the place pose (" + e.message + "): placed there";
+          motion_done();
+          return;
+        }
         fail("the arm stopped during the straight move of " + cycle_state_name(state_) + ": " + e.message);
         return;
       }
-      const Eigen::Isometry3d& target = motion_.waypoints[motion_.waypoint];
-      const Eigen::Vector3d ep = target.translation() - e.end_effector.translation();
       const Eigen::AngleAxisd er(target.linear() * e.end_effector.linear().transpose());
       if (ep.norm() < s_.linear_position_tolerance && std::abs(er.angle()) < s_.linear_orientation_tolerance) {
         if (++motion_.waypoint >= motion_.waypoints.size()) {

@@ -71,6 +71,8 @@ struct CycleSettings {
   double linear_orientation_tolerance = 0.01;
   double stall_s = 1.0;           ///< a guarded place's TCP moving less than stall_distance for this long has stalled
   double stall_distance = 0.001;  ///< metres
+  /// A guarded place that the arm driver stops (a joint limit) with the TCP this close to the place pose is done.
+  double limit_stop_place = 0.01;
   // gripper
   double gripper_open_width = 0.06;
   double gripper_open_tolerance = 0.002;

@@ -84,6 +84,9 @@ class FakeLibrary {
   /// State name -> base z the TCP cannot go below in that state's straight moves (the held book stands on its
   /// support early: it slid down in the plates)
   std::map<std::string, double> floor_z;
+  /// State name -> (point, d): the driver stops a straight move there once the TCP is within d of the point (base),
+  /// as at a joint limit
+  std::map<std::string, std::pair<Eigen::Vector3d, double>> limit_near;
 
   // ---- world ----
   std::deque<FakeBook> upper;
@@ -97,6 +100,7 @@ class FakeLibrary {
   double width = 0.06;
   bool contact = false;
   int arm_state = 0;
+  std::string arm_message;  ///< the driver's message with arm_state
   int64_t active = 0;
   int64_t t = 1000000;
   std::vector<std::string> states;          ///< visited states, consecutive duplicates collapsed
@@ -128,6 +132,7 @@ class FakeLibrary {
     e.gripper_width = width;
     e.gripper_contact = contact;
     e.state = arm_state;
+    e.message = arm_message;
     e.active_command_id = active;
     // Answers held back from earlier ticks reach the cycle after this arm state.
     std::vector<std::function<std::vector<CycleRequest>()>> delayed;
@@ -186,6 +191,12 @@ class FakeLibrary {
       ee.translation() += twist_.head<3>() * dt;
       if (const auto f = floor_z.find(state_now_); f != floor_z.end())
         ee.translation().z() = std::max(ee.translation().z(), f->second);
+      if (const auto l = limit_near.find(state_now_);
+          l != limit_near.end() && (ee.translation() - l->second.first).norm() < l->second.second) {
+        twist_.setZero();
+        arm_state = 2;
+        arm_message = "Cartesian motion reached the limit of joint arm_2_joint: stopped";
+      }
       const Eigen::Vector3d w = twist_.tail<3>();
       if (w.norm() > 1e-12) ee.linear() = Eigen::AngleAxisd(w.norm() * dt, w.normalized()).toRotationMatrix() * ee.linear();
     }
@@ -260,6 +271,7 @@ class FakeLibrary {
         case CycleRequest::Kind::kTwist:
           active = r.id;
           arm_state = 1;
+          arm_message.clear();
           executing_plan_ = false;
           twist_ = r.twist;
           break;

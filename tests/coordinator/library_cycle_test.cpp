@@ -378,6 +378,39 @@ TEST(LibraryCycle, APlaceThatStallsOnItsSupportWithinTheGuardIsDone) {
   }
 }
 
+TEST(LibraryCycle, APlaceThatAJointLimitStopsRightAboveThePoseIsDone) {
+  FakeLibrary free_world(three_books());
+  {
+    LibraryCycle cycle(settings(), std::nullopt);
+    free_world.run(cycle, [&] { return cycle.progress().books_moved >= 1 || done_or_aborted(cycle); });
+    ASSERT_EQ(free_world.lower.size(), 1u);
+  }
+  const Eigen::Vector3d place = free_world.lower[0].second.translation();
+  // The driver stops the place on the lower shelf 3 mm before its pose (within limit_stop_place_m): placed;
+  // 2 cm before (beyond it, though within the stall guard): the place fails.
+  for (const double before : {0.003, 0.02}) {
+    SCOPED_TRACE("stopped " + std::to_string(before) + " m before");
+    FakeLibrary w(three_books());
+    w.limit_near["PLACE_ON_LOWER_SHELF"] = {place, before};
+    const CycleSettings s = settings();
+    ASSERT_GT(s.limit_stop_place, 0.003);
+    ASSERT_LT(s.limit_stop_place, 0.02);
+    ASSERT_GT(s.geometry.lower_place_guard, 0.02);
+    LibraryCycle cycle(s, std::nullopt);
+    w.run(cycle, [&] { return cycle.progress().books_moved >= 1 || done_or_aborted(cycle); });
+    if (before < s.limit_stop_place) {
+      EXPECT_EQ(cycle.progress().books_moved, 1) << cycle.status().message;
+      EXPECT_EQ(cycle.progress().failures, 0);
+      ASSERT_EQ(w.lower.size(), 1u);
+      EXPECT_NEAR((w.lower[0].second.translation() - place).norm(), before, 1e-3);
+    } else {
+      EXPECT_EQ(cycle.state(), CycleState::kAborted);
+      EXPECT_NE(cycle.status().message.find("limit of joint arm_2_joint"), std::string::npos) << cycle.status().message;
+      EXPECT_TRUE(w.in_gripper.has_value());
+    }
+  }
+}
+
 TEST(LibraryCycle, ServoTimeoutInMessageTimeIsAFailure) {
   FakeLibrary w(three_books());
   w.servo_silent = true;
