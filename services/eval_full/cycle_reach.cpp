@@ -41,9 +41,14 @@ Eigen::Isometry3d true_grasp_frame(const scene::Scene& scene) {
 }
 
 std::vector<StageReach> cycle_reach(const scene::Scene& scene, const CycleGeometry& g, const InverseKinematics& ik,
-                                    const Eigen::VectorXd& seed_q) {
+                                    const Eigen::VectorXd& seed_q, size_t book_index) {
   if (scene.books.empty()) throw std::runtime_error("cycle_reach: the scene has no book on the upper shelf");
-  const scene::Book& book = scene.books.front();  // right-most at generation
+  if (book_index >= scene.books.size())
+    throw std::runtime_error("cycle_reach: the scene has " + std::to_string(scene.books.size()) +
+                             " books on the upper shelf, no book " + std::to_string(book_index));
+  const scene::Book& book = scene.books[book_index];  // 0 = right-most at generation
+  double lower_right_y = g.lower_first_right_y;
+  for (size_t i = 0; i < book_index; ++i) lower_right_y -= scene.books[i].width_m + g.lower_gap;
   const Eigen::Isometry3d grasp = true_grasp_frame(scene);
   const Eigen::Isometry3d to_grasp = grasp.inverse();
   const Eigen::Vector3d p1 =
@@ -72,8 +77,8 @@ std::vector<StageReach> cycle_reach(const scene::Scene& scene, const CycleGeomet
   poses.emplace_back("holder_regrasp", holder_place_pose(support, holder_regrasp_height(h, g), g));
   const double held = height_held_from_holder(h, g);
   poses.emplace_back("lower_pre_place",
-                     lower_pre_place_pose(grasp, g.lower_first_right_y, book.width_m, held, std::max(0.0, p1.x()), g));
-  const Eigen::Isometry3d lp = lower_place_pose(grasp, g.lower_first_right_y, book.width_m, held, g);
+                     lower_pre_place_pose(grasp, lower_right_y, book.width_m, held, std::max(0.0, p1.x()), g));
+  const Eigen::Isometry3d lp = lower_place_pose(grasp, lower_right_y, book.width_m, held, g);
   poses.emplace_back("lower_place", lp);
   poses.emplace_back("lower_retreat", move_along_own_axes(lp, Eigen::Vector3d(0, 0, -g.lower_retreat)));
 

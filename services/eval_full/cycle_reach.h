@@ -36,12 +36,13 @@ double elbow_bend_for_tcp(const ArmKinematics& kin, const Eigen::Isometry3d& tcp
 /// The cart's grasp frame in base from the scene's true cart pose (X up, Y right, Z into the shelf).
 Eigen::Isometry3d true_grasp_frame(const scene::Scene& scene);
 
-/// Every stage pose of the first book's cycle (the scene's right-most book, first place on the
-/// lower shelf) from the scene's truth and `g`, each checked with `ik` from `seed_q`:
+/// Every stage pose of the cycle of the scene's book `book_index` (0 = the right-most at generation) from the
+/// scene's truth and `g`, each checked with `ik` from `seed_q`, as if the books right of it had gone to the lower
+/// shelf before it (its place there is left of theirs, `g.lower_gap` apart; their pushes are not modelled):
 /// stripe_start, stripe_end, bwh_start, pre_grasp, grasp, extract_lift, extract_end,
 /// holder_pre_place, holder_place, holder_retreat, holder_regrasp, lower_pre_place, lower_place, lower_retreat.
-/// Throws std::runtime_error if the scene has no book.
+/// Throws std::runtime_error if the scene has no such book.
 std::vector<StageReach> cycle_reach(const scene::Scene& scene, const CycleGeometry& g, const InverseKinematics& ik,
-                                    const Eigen::VectorXd& seed_q);
+                                    const Eigen::VectorXd& seed_q, size_t book_index = 0);
 
 }  // namespace bookgrasp

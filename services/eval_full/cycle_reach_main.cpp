@@ -1,6 +1,6 @@
 /// @file
 /// bookgrasp_cycle_reach: for N seeded scenes, whether the arm can reach every pose of the first
-/// book's library cycle (cycle_reach.h), from the scene's truth and the coordinator's geometry, in
+/// book's library cycle, or of every book's (--all-books) (cycle_reach.h), from the scene's truth and the coordinator's geometry, in
 /// milliseconds per scene instead of minutes of composed simulation. Prints one line per scene and
 /// the unreachable count per stage; use it to try a geometry (scene file, URDF, coordinator keys)
 /// before running bookgrasp_eval_full.
@@ -26,6 +26,7 @@ void usage(std::ostream& os) {
         "  --urdf FILE         robot description (default: the scene's robot.urdf)\n"
         "  --set KEY=VALUE     override a coordinator key (dotted, e.g. geometry.grasp.extract_retreat_m=0.31)\n"
         "  --planner-ik FILE   the IK settings of a planner YAML (ik:) instead of 24 restarts from defaults\n"
+        "  --all-books         every book of the upper shelf, each as if the books right of it had gone before\n"
         "  --verbose           every stage of every scene with the elbow bend it needs\n"
         "  --source-dir DIR    project tree (default: the one this tool was built from)\n";
 }
@@ -53,7 +54,7 @@ int main(int argc, char** argv) {
   using namespace bookgrasp;
   int scenes = -1;
   long long seed = -1;
-  bool verbose = false;
+  bool verbose = false, all_books = false;
   std::string source_dir = BOOKGRASP_SOURCE_DIR, scene_file, coord_file, urdf, planner_ik;
   std::vector<std::string> sets;
   try {
@@ -79,6 +80,8 @@ int main(int argc, char** argv) {
         planner_ik = value();
       else if (a == "--verbose")
         verbose = true;
+      else if (a == "--all-books")
+        all_books = true;
       else if (a == "--source-dir")
         source_dir = value();
       else if (a == "--help" || a == "-h") {
@@ -103,7 +106,7 @@ int main(int argc, char** argv) {
 
     std::map<std::string, int> unreachable;
     std::vector<std::string> order;
-    int all_ok = 0;
+    int all_ok = 0, books = 0;
     for (int k = 0; k < scenes; ++k) {
       const uint64_t s = static_cast<uint64_t>(seed + k);
       const scene::Scene scene = scene::load_scene(scene_file, s);
@@ -129,8 +132,10 @@ int main(int argc, char** argv) {
       const InverseKinematics ik(kin, p);
       Eigen::VectorXd q0(7);
       for (int j = 0; j < 7; ++j) q0[j] = park[j] * M_PI / 180.0;
-      const std::vector<StageReach> r = cycle_reach(scene, g, ik, q0);
-      const scene::Book& b = scene.books.front();
+      for (size_t bi = 0; bi < (all_books ? scene.books.size() : 1); ++bi) {
+      const std::vector<StageReach> r = cycle_reach(scene, g, ik, q0, bi);
+      const scene::Book& b = scene.books[bi];
+      ++books;
       std::string failed;
       for (const StageReach& st : r) {
         if (order.size() < r.size()) order.push_back(st.stage);
@@ -140,7 +145,7 @@ int main(int argc, char** argv) {
         }
       }
       all_ok += failed.empty();
-      std::printf("seed %llu: book y %+.3f m (base), height %.3f m: %s\n", static_cast<unsigned long long>(s),
+      std::printf("seed %llu book %zu: y %+.3f m (base), height %.3f m: %s\n", static_cast<unsigned long long>(s), bi,
                   b.pose.translation().y(), b.height_m,
                   failed.empty() ? "all reachable" : ("UNREACHABLE " + failed).c_str());
       if (verbose) {
@@ -164,8 +169,12 @@ int main(int argc, char** argv) {
           std::printf("    %-17s tcp (%+.3f %+.3f %+.3f)  elbow needs %6.1f deg  %s\n", st.stage.c_str(),
                       st.tcp.translation().x(), st.tcp.translation().y(), st.tcp.translation().z(),
                       st.elbow_needed_rad * 180.0 / M_PI, st.reachable ? "ok" : st.reason.c_str());
+      }
     }
-    std::printf("\n%d of %d scenes: every stage of the first book's cycle reachable\n", all_ok, scenes);
+    if (all_books)
+      std::printf("\n%d of %d books (%d scenes): every stage of the book's cycle reachable\n", all_ok, books, scenes);
+    else
+      std::printf("\n%d of %d scenes: every stage of the first book's cycle reachable\n", all_ok, scenes);
     for (const std::string& st : order) std::printf("  %-17s unreachable in %d\n", st.c_str(), unreachable[st]);
     return 0;
   } catch (const std::exception& e) {

@@ -126,6 +126,35 @@ TEST(CycleReach, TheDiagonalLiftReachesTheRightEndsBooksTheStraightLiftDoesNot) 
   }
 }
 
+// A later book's cycle: its own corner, and its place on the lower shelf left of the books before it.
+TEST(CycleReach, ALaterBooksCycleGraspsItAndPlacesItLeftOfTheEarlierOnes) {
+  const InverseKinematics ik(arm(), IkParams{});
+  Eigen::VectorXd park = Eigen::VectorXd::Zero(7);
+  const scene::Scene scene = scene::load_scene(kSrc + "/config/scenes/far_cart.yaml", 2);
+  ASSERT_GE(scene.books.size(), 3u);
+  const CycleGeometry g = coordinator_geometry();
+  const auto stage = [](const std::vector<StageReach>& r, const std::string& name) {
+    for (const StageReach& st : r)
+      if (st.stage == name) return st.tcp;
+    ADD_FAILURE() << "no stage " << name;
+    return Eigen::Isometry3d::Identity();
+  };
+  const std::vector<StageReach> first = cycle_reach(scene, g, ik, park, 0);
+  const std::vector<StageReach> third = cycle_reach(scene, g, ik, park, 2);
+  // The grasp is on the third book: its TCP lies (grasp Y, i.e. -base y) as far left of the first's as the books.
+  const double books_apart = scene.books[2].pose.translation().y() - scene.books[0].pose.translation().y();
+  EXPECT_GT(books_apart, 0.0);
+  const double grasps_apart = stage(third, "grasp").translation().y() - stage(first, "grasp").translation().y();
+  EXPECT_NEAR(grasps_apart, books_apart, 0.01);  // the covers' Y, not the centres': widths differ by < 2.5 cm / 2
+  // Its lower-shelf place is left of the first's by the two earlier books' widths and gaps, plus half the width
+  // difference (the TCP is at the book's middle).
+  const double expect = scene.books[0].width_m + scene.books[1].width_m + 2 * g.lower_gap +
+                        (scene.books[2].width_m - scene.books[0].width_m) / 2;
+  EXPECT_NEAR(stage(third, "lower_place").translation().y() - stage(first, "lower_place").translation().y(), expect,
+              1e-9);
+  EXPECT_THROW(cycle_reach(scene, g, ik, park, scene.books.size()), std::runtime_error);
+}
+
 TEST(CycleReach, SceneWithoutBooksIsAClearError) {
   scene::Scene scene = scene::load_scene(kSrc + "/config/scenes/default.yaml", 1);
   scene.books.clear();
