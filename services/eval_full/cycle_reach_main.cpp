@@ -1,9 +1,9 @@
 /// @file
 /// bookgrasp_cycle_reach: for N seeded scenes, whether the arm can reach every pose of the first
-/// book's library cycle, or of every book's (--all-books) (cycle_reach.h), from the scene's truth and the coordinator's geometry, in
-/// milliseconds per scene instead of minutes of composed simulation. Prints one line per scene and
-/// the unreachable count per stage; use it to try a geometry (scene file, URDF, coordinator keys)
-/// before running bookgrasp_eval_full.
+/// book's library cycle, or of every book's (--all-books) (cycle_reach.h), from the scene's truth and the coordinator's
+/// geometry, in milliseconds per scene instead of minutes of composed simulation. Prints one line per scene and the
+/// unreachable count per stage; use it to try a geometry (scene file, URDF, coordinator keys) before running
+/// bookgrasp_eval_full.
 
 #include <cmath>
 #include <cstdio>
@@ -133,42 +133,42 @@ int main(int argc, char** argv) {
       Eigen::VectorXd q0(7);
       for (int j = 0; j < 7; ++j) q0[j] = park[j] * M_PI / 180.0;
       for (size_t bi = 0; bi < (all_books ? scene.books.size() : 1); ++bi) {
-      const std::vector<StageReach> r = cycle_reach(scene, g, ik, q0, bi);
-      const scene::Book& b = scene.books[bi];
-      ++books;
-      std::string failed;
-      for (const StageReach& st : r) {
-        if (order.size() < r.size()) order.push_back(st.stage);
-        if (!st.reachable) {
-          ++unreachable[st.stage];
-          failed += (failed.empty() ? "" : ",") + st.stage;
+        const std::vector<StageReach> r = cycle_reach(scene, g, ik, q0, bi);
+        const scene::Book& b = scene.books[bi];
+        ++books;
+        std::string failed;
+        for (const StageReach& st : r) {
+          if (order.size() < r.size()) order.push_back(st.stage);
+          if (!st.reachable) {
+            ++unreachable[st.stage];
+            failed += (failed.empty() ? "" : ",") + st.stage;
+          }
         }
-      }
-      all_ok += failed.empty();
-      std::printf("seed %llu book %zu: y %+.3f m (base), height %.3f m: %s\n", static_cast<unsigned long long>(s), bi,
-                  b.pose.translation().y(), b.height_m,
-                  failed.empty() ? "all reachable" : ("UNREACHABLE " + failed).c_str());
-      if (verbose) {
-        // The frames the coordinator derives from the markers (AprilTag axes: y down, z into the tag) vs the truth.
-        const Eigen::Isometry3d flip(Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitX()));
-        const Eigen::Isometry3d sup = holder_support_frame(scene.holder_marker.pose * flip, g);
-        const Eigen::Isometry3d grf = cart_grasp_frame(scene.cart_marker.pose * flip, g);
-        const Eigen::Isometry3d gt = true_grasp_frame(scene);
-        std::printf("    holder support from its marker - truth: (%+.4f %+.4f %+.4f) m, %.4f rad\n",
-                    (sup.translation() - scene.holder_support_pose.translation()).x(),
-                    (sup.translation() - scene.holder_support_pose.translation()).y(),
-                    (sup.translation() - scene.holder_support_pose.translation()).z(),
-                    Eigen::AngleAxisd(sup.linear().transpose() * scene.holder_support_pose.linear()).angle());
-        std::printf("    grasp frame from the cart marker - truth: (%+.4f %+.4f %+.4f) m, %.4f rad\n",
-                    (grf.translation() - gt.translation()).x(), (grf.translation() - gt.translation()).y(),
-                    (grf.translation() - gt.translation()).z(),
-                    Eigen::AngleAxisd(grf.linear().transpose() * gt.linear()).angle());
-      }
-      if (verbose)
-        for (const StageReach& st : r)
-          std::printf("    %-17s tcp (%+.3f %+.3f %+.3f)  elbow needs %6.1f deg  %s\n", st.stage.c_str(),
-                      st.tcp.translation().x(), st.tcp.translation().y(), st.tcp.translation().z(),
-                      st.elbow_needed_rad * 180.0 / M_PI, st.reachable ? "ok" : st.reason.c_str());
+        all_ok += failed.empty();
+        std::printf("seed %llu book %zu: y %+.3f m (base), height %.3f m: %s\n", static_cast<unsigned long long>(s), bi,
+                    b.pose.translation().y(), b.height_m,
+                    failed.empty() ? "all reachable" : ("UNREACHABLE " + failed).c_str());
+        if (verbose) {
+          // The frames the coordinator derives from the markers (AprilTag axes: y down, z into the tag) vs the truth.
+          const Eigen::Isometry3d flip(Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitX()));
+          const Eigen::Isometry3d sup = holder_support_frame(scene.holder_marker.pose * flip, g);
+          const Eigen::Isometry3d grf = cart_grasp_frame(scene.cart_marker.pose * flip, g);
+          const Eigen::Isometry3d gt = true_grasp_frame(scene);
+          std::printf("    holder support from its marker - truth: (%+.4f %+.4f %+.4f) m, %.4f rad\n",
+                      (sup.translation() - scene.holder_support_pose.translation()).x(),
+                      (sup.translation() - scene.holder_support_pose.translation()).y(),
+                      (sup.translation() - scene.holder_support_pose.translation()).z(),
+                      Eigen::AngleAxisd(sup.linear().transpose() * scene.holder_support_pose.linear()).angle());
+          std::printf("    grasp frame from the cart marker - truth: (%+.4f %+.4f %+.4f) m, %.4f rad\n",
+                      (grf.translation() - gt.translation()).x(), (grf.translation() - gt.translation()).y(),
+                      (grf.translation() - gt.translation()).z(),
+                      Eigen::AngleAxisd(grf.linear().transpose() * gt.linear()).angle());
+        }
+        if (verbose)
+          for (const StageReach& st : r)
+            std::printf("    %-17s tcp (%+.3f %+.3f %+.3f)  elbow needs %6.1f deg  %s\n", st.stage.c_str(),
+                        st.tcp.translation().x(), st.tcp.translation().y(), st.tcp.translation().z(),
+                        st.elbow_needed_rad * 180.0 / M_PI, st.reachable ? "ok" : st.reason.c_str());
       }
     }
     if (all_books)
