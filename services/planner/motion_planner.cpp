@@ -232,14 +232,20 @@ PlanOutcome MotionPlanner::plan(const PlanningScene& scene, const PlanRequest& r
   const bool keep = req.keep_orientation;
   if (!(req.max_tool_tilt_rad >= 0) || !std::isfinite(req.max_tool_tilt_rad))
     return fail(PlanFailure::kInvalidRequest, "max_tool_tilt_rad must be finite and >= 0");
+  if (!(req.max_tool_pitch_rad >= 0) || !std::isfinite(req.max_tool_pitch_rad) || req.max_tool_pitch_rad > M_PI / 2)
+    return fail(PlanFailure::kInvalidRequest, "max_tool_pitch_rad must be finite and within [0, pi/2]");
   const double min_up = req.max_tool_tilt_rad > 0 ? std::cos(req.max_tool_tilt_rad) : -2.0;
+  const double max_pitch_sin = req.max_tool_pitch_rad > 0 ? std::sin(req.max_tool_pitch_rad) : 2.0;
   // Tilt of the tool's x axis from base +z (cosine = its z component).
   const auto tilt_of = [](const Eigen::Matrix3d& r) { return std::acos(std::clamp(r(2, 0), -1.0, 1.0)); };
-  const StateCheck valid = [&scene, &kin, keep, kept, band, min_up](const Eigen::VectorXd& q) {
-    if (keep || min_up > -1.5) {
+  // Pitch of the tool's z axis from the horizontal plane (sine = the magnitude of its z component).
+  const auto pitch_of = [](const Eigen::Matrix3d& r) { return std::asin(std::clamp(std::abs(r(2, 2)), 0.0, 1.0)); };
+  const StateCheck valid = [&scene, &kin, keep, kept, band, min_up, max_pitch_sin](const Eigen::VectorXd& q) {
+    if (keep || min_up > -1.5 || max_pitch_sin < 1.5) {
       const Eigen::Matrix3d r = kin.tip_pose(q).linear();
       if (keep && rotation_angle(r, kept) > band) return false;
       if (r(2, 0) < min_up) return false;
+      if (std::abs(r(2, 2)) > max_pitch_sin) return false;
     }
     return scene.is_valid(q);
   };
@@ -254,6 +260,18 @@ PlanOutcome MotionPlanner::plan(const PlanningScene& scene, const PlanRequest& r
       return fail(PlanFailure::kInvalidRequest, "the goal tilts the tool's x axis " + fmt(tilt_of(goal_r)) +
                                                     " rad from upright, more than max_tool_tilt_rad " +
                                                     fmt(req.max_tool_tilt_rad));
+  }
+  if (req.max_tool_pitch_rad > 0) {
+    if (pitch_of(start_tip.linear()) > req.max_tool_pitch_rad)
+      return fail(PlanFailure::kInvalidRequest,
+                  "the start pitches the tool's z axis " + fmt(pitch_of(start_tip.linear())) +
+                      " rad from horizontal, more than max_tool_pitch_rad " + fmt(req.max_tool_pitch_rad));
+    const Eigen::Matrix3d goal_r = req.goal_is_pose ? Eigen::Matrix3d(req.goal_pose.linear())
+                                                    : Eigen::Matrix3d(kin.tip_pose(req.goal_joints).linear());
+    if (pitch_of(goal_r) > req.max_tool_pitch_rad)
+      return fail(PlanFailure::kInvalidRequest, "the goal pitches the tool's z axis " + fmt(pitch_of(goal_r)) +
+                                                    " rad from horizontal, more than max_tool_pitch_rad " +
+                                                    fmt(req.max_tool_pitch_rad));
   }
   const CollisionReport start_report = scene.check(start);
   if (start_report.collision)

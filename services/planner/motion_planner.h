@@ -45,6 +45,9 @@ struct PlanRequest {
   /// > 0: along the whole path the tool's x axis stays within this angle of base +z (a held book, whose
   /// up is the gripper's x, stays upright); start and goal must meet it. 0 = no such constraint.
   double max_tool_tilt_rad = 0.0;
+  /// > 0: along the whole path the tool's z axis (the approach) stays within this angle of horizontal (a held
+  /// book does not creep along the plates towards their tips); start and goal must meet it. 0 = no such constraint.
+  double max_tool_pitch_rad = 0.0;
   double time_budget_s = 1.0;             ///< planning time limit (wall clock)
   std::string planner;                    ///< "CellBiRRT", "RRTConnect", "BiTRRT"; "" = default
   uint64_t seed = 1;                      ///< random seed (same request + seed -> same path)

@@ -75,6 +75,7 @@ PlannerSettings PlannerSettings::from_config(const Config& root) {
   s.held_book.top_above_tcp_m = hb.get_double("top_above_tcp_m", -0.5, 0.5);
   s.held_book.behind_tcp_m = hb.get_double("behind_tcp_m", -0.5, 0.5);
   s.held_book.max_tilt_rad = hb.get_double("max_tilt_deg", 0.0, 90.0) * M_PI / 180.0;
+  s.held_book.max_pitch_rad = hb.get_double("max_pitch_deg", 0.0, 90.0) * M_PI / 180.0;
   s.held_book.environment_margin_m = hb.get_double("environment_margin_m", 0.0, 0.5);
 
   const Config pl = root.child("planner");

@@ -21,6 +21,7 @@ struct HeldBookParams {
   double top_above_tcp_m = 0.015;        ///< book top above the TCP (gripper +x)
   double behind_tcp_m = 0.03;            ///< fore-edge behind the TCP (gripper -z)
   double max_tilt_rad = 0.0;             ///< > 0: a planned path keeps the book (gripper x) this upright
+  double max_pitch_rad = 0.0;            ///< > 0: ... and the approach (gripper z) this near horizontal
   double environment_margin_m = -1.0;    ///< the book's distance to keep from the environment (< 0: the scene's)
 };
 

@@ -109,7 +109,10 @@ plan_result_t PlannerNode::process(const plan_request_t& req) const {
   r.position_tolerance_m = req.position_tolerance_m;
   r.orientation_tolerance_rad = req.orientation_tolerance_rad;
   r.keep_orientation = req.keep_orientation;
-  if (req.holding_book) r.max_tool_tilt_rad = settings_.held_book.max_tilt_rad;
+  if (req.holding_book) {
+    r.max_tool_tilt_rad = settings_.held_book.max_tilt_rad;
+    r.max_tool_pitch_rad = settings_.held_book.max_pitch_rad;
+  }
   r.time_budget_s = req.time_budget_s > 0 ? req.time_budget_s : settings_.default_time_budget_s;
   r.planner = req.planner;
   r.seed = mix_seed(static_cast<uint64_t>(req.utime) ^ mix_seed(static_cast<uint64_t>(req.request_id)) ^ settings_.ik.seed);

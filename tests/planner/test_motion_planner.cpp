@@ -211,6 +211,60 @@ TEST_F(MotionPlannerTest, MaxToolTiltKeepsAHeldBookUprightAlongThePath) {
   EXPECT_NE(refused.message.find("the goal tilts"), std::string::npos) << refused.message;
 }
 
+TEST_F(MotionPlannerTest, APitchLimitKeepsTheApproachLevelAlongThePath) {
+  // The same move as above (book out of the shelf -> along the holder's plate) with the gripper's z (the
+  // approach, along which a held book creeps towards the plates' tips when it points down) kept within 8 deg
+  // of horizontal at every state of the path and of the timed trajectory.
+  scene_->set_environment({box("floor", {0, 0, -0.6}, {3, 3, 0.1})});
+  const double max_pitch = 8.0 * M_PI / 180.0;
+  Eigen::Isometry3d a = Eigen::Isometry3d::Identity(), b = Eigen::Isometry3d::Identity();
+  a.linear().col(0) = Eigen::Vector3d::UnitZ();
+  a.linear().col(1) = -Eigen::Vector3d::UnitY();
+  a.linear().col(2) = Eigen::Vector3d::UnitX();
+  a.translation() = Eigen::Vector3d(0.85, -0.05, 0.45);
+  const double lean = 15.0 * M_PI / 180.0;
+  b.linear().col(0) = Eigen::Vector3d(std::sin(lean), 0, std::cos(lean));
+  b.linear().col(1) = Eigen::Vector3d(std::cos(lean), 0, -std::sin(lean));
+  b.linear().col(2) = b.linear().col(0).cross(b.linear().col(1));
+  b.translation() = Eigen::Vector3d(0.63, 0.16, 0.10);
+  const IkResult ia = stack_.ik.solve(a, settings_.ik.preferred_posture);
+  ASSERT_TRUE(ia.success && scene_->is_valid(ia.q)) << ia.reason;
+  PlanRequest req;
+  req.start = ia.q;
+  req.goal_is_pose = true;
+  req.goal_pose = b;
+  req.max_tool_tilt_rad = 30.0 * M_PI / 180.0;
+  req.max_tool_pitch_rad = max_pitch;
+  req.time_budget_s = 3.0;
+  const auto pitch = [&](const Eigen::VectorXd& q) {
+    return std::asin(std::min(1.0, std::abs(stack_.kinematics.tip_pose(q).linear()(2, 2))));
+  };
+  for (uint64_t seed : {1, 2}) {
+    SCOPED_TRACE("seed " + std::to_string(seed));
+    req.seed = seed;
+    const PlanOutcome r = stack_.planner.plan(*scene_, req);
+    ASSERT_TRUE(r.success) << r.message;
+    expect_collision_free(*scene_, r);
+    for (size_t i = 1; i < r.path.size(); ++i)
+      for (int k = 0; k <= 100; ++k)
+        EXPECT_LE(pitch(r.path[i - 1] + (k / 100.0) * (r.path[i] - r.path[i - 1])), max_pitch + 0.01)
+            << "segment " << i << " step " << k;
+    for (const auto& p : r.trajectory.points) EXPECT_LE(pitch(p.position), max_pitch + 0.01) << "at " << p.time_s << " s";
+  }
+  // A goal whose approach points 20 deg down is refused, saying why; so is a bad limit.
+  const Eigen::Isometry3d down = b * Eigen::AngleAxisd(20.0 * M_PI / 180.0, Eigen::Vector3d::UnitY());
+  req.goal_pose.linear() = down.linear();
+  req.max_tool_tilt_rad = 0.0;
+  const PlanOutcome refused = stack_.planner.plan(*scene_, req);
+  EXPECT_FALSE(refused.success);
+  EXPECT_EQ(refused.failure, PlanFailure::kInvalidRequest);
+  EXPECT_NE(refused.message.find("the goal pitches"), std::string::npos) << refused.message;
+  req.max_tool_pitch_rad = std::nan("");
+  const PlanOutcome bad = stack_.planner.plan(*scene_, req);
+  EXPECT_EQ(bad.failure, PlanFailure::kInvalidRequest);
+  EXPECT_NE(bad.message.find("max_tool_pitch_rad"), std::string::npos) << bad.message;
+}
+
 TEST_F(MotionPlannerTest, FailureReasons) {
   PlanRequest req;
   req.start = start_;
