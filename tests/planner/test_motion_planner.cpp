@@ -249,7 +249,8 @@ TEST_F(MotionPlannerTest, APitchLimitKeepsTheApproachLevelAlongThePath) {
       for (int k = 0; k <= 100; ++k)
         EXPECT_LE(pitch(r.path[i - 1] + (k / 100.0) * (r.path[i] - r.path[i - 1])), max_pitch + 0.01)
             << "segment " << i << " step " << k;
-    for (const auto& p : r.trajectory.points) EXPECT_LE(pitch(p.position), max_pitch + 0.01) << "at " << p.time_s << " s";
+    for (const auto& p : r.trajectory.points)
+      EXPECT_LE(pitch(p.position), max_pitch + 0.01) << "at " << p.time_s << " s";
   }
   // A goal whose approach points 20 deg down is refused, saying why; so is a bad limit.
   const Eigen::Isometry3d down = b * Eigen::AngleAxisd(20.0 * M_PI / 180.0, Eigen::Vector3d::UnitY());
