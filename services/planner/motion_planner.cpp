@@ -1,6 +1,7 @@
 #include "services/planner/motion_planner.h"
 
 #include <algorithm>
+#include <functional>
 #include <chrono>
 #include <cmath>
 #include <memory>
@@ -249,29 +250,26 @@ PlanOutcome MotionPlanner::plan(const PlanningScene& scene, const PlanRequest& r
     }
     return scene.is_valid(q);
   };
-  if (req.max_tool_tilt_rad > 0) {
-    if (tilt_of(start_tip.linear()) > req.max_tool_tilt_rad)
-      return fail(PlanFailure::kInvalidRequest,
-                  "the start tilts the tool's x axis " + fmt(tilt_of(start_tip.linear())) +
-                      " rad from upright, more than max_tool_tilt_rad " + fmt(req.max_tool_tilt_rad));
-    const Eigen::Matrix3d goal_r = req.goal_is_pose ? Eigen::Matrix3d(req.goal_pose.linear())
-                                                    : Eigen::Matrix3d(kin.tip_pose(req.goal_joints).linear());
-    if (tilt_of(goal_r) > req.max_tool_tilt_rad)
-      return fail(PlanFailure::kInvalidRequest, "the goal tilts the tool's x axis " + fmt(tilt_of(goal_r)) +
-                                                    " rad from upright, more than max_tool_tilt_rad " +
-                                                    fmt(req.max_tool_tilt_rad));
-  }
-  if (req.max_tool_pitch_rad > 0) {
-    if (pitch_of(start_tip.linear()) > req.max_tool_pitch_rad)
-      return fail(PlanFailure::kInvalidRequest,
-                  "the start pitches the tool's z axis " + fmt(pitch_of(start_tip.linear())) +
-                      " rad from horizontal, more than max_tool_pitch_rad " + fmt(req.max_tool_pitch_rad));
-    const Eigen::Matrix3d goal_r = req.goal_is_pose ? Eigen::Matrix3d(req.goal_pose.linear())
-                                                    : Eigen::Matrix3d(kin.tip_pose(req.goal_joints).linear());
-    if (pitch_of(goal_r) > req.max_tool_pitch_rad)
-      return fail(PlanFailure::kInvalidRequest, "the goal pitches the tool's z axis " + fmt(pitch_of(goal_r)) +
-                                                    " rad from horizontal, more than max_tool_pitch_rad " +
-                                                    fmt(req.max_tool_pitch_rad));
+  // Start and goal must meet the orientation bounds the path keeps.
+  const Eigen::Matrix3d goal_r = req.goal_is_pose ? Eigen::Matrix3d(req.goal_pose.linear())
+                                                  : Eigen::Matrix3d(kin.tip_pose(req.goal_joints).linear());
+  struct Bound {
+    double limit;
+    std::function<double(const Eigen::Matrix3d&)> angle;
+    const char* what;  // "<verb> the tool's <axis> axis"
+    const char* from;  // "upright" / "horizontal"
+    const char* key;
+  };
+  for (const Bound& b : {Bound{req.max_tool_tilt_rad, tilt_of, "tilts the tool's x axis", "upright", "max_tool_tilt_rad"},
+                         Bound{req.max_tool_pitch_rad, pitch_of, "pitches the tool's z axis", "horizontal",
+                               "max_tool_pitch_rad"}}) {
+    if (!(b.limit > 0)) continue;
+    for (const auto& [end_name, r] : {std::pair<const char*, Eigen::Matrix3d>{"start", start_tip.linear()},
+                                      std::pair<const char*, Eigen::Matrix3d>{"goal", goal_r}})
+      if (b.angle(r) > b.limit)
+        return fail(PlanFailure::kInvalidRequest, std::string("the ") + end_name + " " + b.what + " " +
+                                                      fmt(b.angle(r)) + " rad from " + b.from + ", more than " +
+                                                      b.key + " " + fmt(b.limit));
   }
   const CollisionReport start_report = scene.check(start);
   if (start_report.collision)

@@ -18,6 +18,18 @@ ArmKinematics arm() {
   return ArmKinematics::from_urdf_file(kSrc + "/config/robot/lwa3_pg70.urdf", "base", "gripper");
 }
 
+// The IK of bookgrasp_cycle_reach (24 restarts) and the park posture it starts from.
+IkParams restarts_24() {
+  IkParams p;
+  p.max_restarts = 24;
+  return p;
+}
+Eigen::VectorXd park_joints() {
+  Eigen::VectorXd park(7);
+  park << 0, -M_PI / 2, 0, -M_PI / 2, 0, -M_PI / 2, 0;
+  return park;
+}
+
 CycleGeometry coordinator_geometry() {
   return CycleGeometry::from_config(Config::load_file(kSrc + "/config/services/coordinator.yaml").child("geometry"));
 }
@@ -67,11 +79,8 @@ TEST(CycleReach, TrueGraspFrameHasXUpYRightZIntoTheShelf) {
 // a bend beyond the limit (or out of reach) or the IK says why.
 TEST(CycleReach, StagesAgreeWithForwardKinematicsAndTheElbowLimit) {
   const ArmKinematics kin = arm();
-  IkParams p;
-  p.max_restarts = 24;
-  const InverseKinematics ik(kin, p);
-  Eigen::VectorXd park(7);
-  park << 0, -M_PI / 2, 0, -M_PI / 2, 0, -M_PI / 2, 0;
+  const InverseKinematics ik(kin, restarts_24());
+  const Eigen::VectorXd park = park_joints();
   const double limit = kin.upper_limits()[3];
   int reachable = 0, stages = 0;
   for (uint64_t seed = 1; seed <= 3; ++seed) {
@@ -102,11 +111,8 @@ TEST(CycleReach, StagesAgreeWithForwardKinematicsAndTheElbowLimit) {
 // (geometry.grasp.extract_lift_out_m) reaches it and the end of the extraction.
 TEST(CycleReach, TheDiagonalLiftReachesTheRightEndsBooksTheStraightLiftDoesNot) {
   const ArmKinematics kin = arm();
-  IkParams p;
-  p.max_restarts = 24;
-  const InverseKinematics ik(kin, p);
-  Eigen::VectorXd park(7);
-  park << 0, -M_PI / 2, 0, -M_PI / 2, 0, -M_PI / 2, 0;
+  const InverseKinematics ik(kin, restarts_24());
+  const Eigen::VectorXd park = park_joints();
   const CycleGeometry shipped = coordinator_geometry();
   ASSERT_GT(shipped.extract_lift_out, 0.0);
   CycleGeometry straight = shipped;

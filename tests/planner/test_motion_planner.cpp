@@ -155,6 +155,27 @@ TEST_F(MotionPlannerTest, KeepOrientationHoldsTheGripperAlongThePath) {
   }
 }
 
+// The gripper after an extraction: pointing forward over the cart (x up, z along base x).
+Eigen::Isometry3d book_out_of_the_shelf() {
+  Eigen::Isometry3d a = Eigen::Isometry3d::Identity();
+  a.linear().col(0) = Eigen::Vector3d::UnitZ();
+  a.linear().col(1) = -Eigen::Vector3d::UnitY();
+  a.linear().col(2) = Eigen::Vector3d::UnitX();
+  a.translation() = Eigen::Vector3d(0.85, -0.05, 0.45);
+  return a;
+}
+
+// The gripper placing on the holder: pointing left, x leaning 15 degrees back along the holder's plate.
+Eigen::Isometry3d along_the_holders_plate() {
+  Eigen::Isometry3d b = Eigen::Isometry3d::Identity();
+  const double lean = 15.0 * M_PI / 180.0;
+  b.linear().col(0) = Eigen::Vector3d(std::sin(lean), 0, std::cos(lean));
+  b.linear().col(1) = Eigen::Vector3d(std::cos(lean), 0, -std::sin(lean));
+  b.linear().col(2) = b.linear().col(0).cross(b.linear().col(1));
+  b.translation() = Eigen::Vector3d(0.63, 0.16, 0.10);
+  return b;
+}
+
 TEST_F(MotionPlannerTest, MaxToolTiltKeepsAHeldBookUprightAlongThePath) {
   // The move to the book holder (config/scenes/far_cart.yaml): from a gripper pointing forward over the cart
   // after the extraction to one pointing left and leaning 15 degrees along the holder's back plate. Every
@@ -162,18 +183,7 @@ TEST_F(MotionPlannerTest, MaxToolTiltKeepsAHeldBookUprightAlongThePath) {
   // degrees of vertical; without the constraint the planner's path turned the book over (docs/EVALUATION.md).
   scene_->set_environment({box("floor", {0, 0, -0.6}, {3, 3, 0.1})});
   const double max_tilt = 30.0 * M_PI / 180.0;
-  Eigen::Matrix3d r0;
-  r0.col(0) = Eigen::Vector3d::UnitZ();
-  r0.col(1) = -Eigen::Vector3d::UnitY();
-  r0.col(2) = Eigen::Vector3d::UnitX();
-  Eigen::Isometry3d a = Eigen::Isometry3d::Identity(), b = Eigen::Isometry3d::Identity();
-  a.linear() = r0;
-  a.translation() = Eigen::Vector3d(0.85, -0.05, 0.45);
-  const double lean = 15.0 * M_PI / 180.0;
-  b.linear().col(0) = Eigen::Vector3d(std::sin(lean), 0, std::cos(lean));
-  b.linear().col(1) = Eigen::Vector3d(std::cos(lean), 0, -std::sin(lean));
-  b.linear().col(2) = b.linear().col(0).cross(b.linear().col(1));
-  b.translation() = Eigen::Vector3d(0.63, 0.16, 0.10);
+  const Eigen::Isometry3d a = book_out_of_the_shelf(), b = along_the_holders_plate();
   const IkResult ia = stack_.ik.solve(a, settings_.ik.preferred_posture);
   ASSERT_TRUE(ia.success && scene_->is_valid(ia.q)) << ia.reason;
   const IkResult ib = stack_.ik.solve(b, settings_.ik.preferred_posture);
@@ -217,16 +227,7 @@ TEST_F(MotionPlannerTest, APitchLimitKeepsTheApproachLevelAlongThePath) {
   // of horizontal at every state of the path and of the timed trajectory.
   scene_->set_environment({box("floor", {0, 0, -0.6}, {3, 3, 0.1})});
   const double max_pitch = 8.0 * M_PI / 180.0;
-  Eigen::Isometry3d a = Eigen::Isometry3d::Identity(), b = Eigen::Isometry3d::Identity();
-  a.linear().col(0) = Eigen::Vector3d::UnitZ();
-  a.linear().col(1) = -Eigen::Vector3d::UnitY();
-  a.linear().col(2) = Eigen::Vector3d::UnitX();
-  a.translation() = Eigen::Vector3d(0.85, -0.05, 0.45);
-  const double lean = 15.0 * M_PI / 180.0;
-  b.linear().col(0) = Eigen::Vector3d(std::sin(lean), 0, std::cos(lean));
-  b.linear().col(1) = Eigen::Vector3d(std::cos(lean), 0, -std::sin(lean));
-  b.linear().col(2) = b.linear().col(0).cross(b.linear().col(1));
-  b.translation() = Eigen::Vector3d(0.63, 0.16, 0.10);
+  const Eigen::Isometry3d a = book_out_of_the_shelf(), b = along_the_holders_plate();
   const IkResult ia = stack_.ik.solve(a, settings_.ik.preferred_posture);
   ASSERT_TRUE(ia.success && scene_->is_valid(ia.q)) << ia.reason;
   PlanRequest req;
