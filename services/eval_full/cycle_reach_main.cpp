@@ -148,8 +148,9 @@ int main(int argc, char** argv) {
         std::printf("seed %llu book %zu: y %+.3f m (base), height %.3f m: %s\n", static_cast<unsigned long long>(s), bi,
                     b.pose.translation().y(), b.height_m,
                     failed.empty() ? "all reachable" : ("UNREACHABLE " + failed).c_str());
-        if (verbose) {
-          // The frames the coordinator derives from the markers (AprilTag axes: y down, z into the tag) vs the truth.
+        if (verbose && bi == 0) {
+          // The frames the coordinator derives from the markers (AprilTag axes: y down, z into the tag) vs the truth:
+          // once a scene.
           const Eigen::Isometry3d flip(Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitX()));
           const Eigen::Isometry3d sup = holder_support_frame(scene.holder_marker.pose * flip, g);
           const Eigen::Isometry3d grf = cart_grasp_frame(scene.cart_marker.pose * flip, g);

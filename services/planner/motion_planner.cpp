@@ -1,9 +1,9 @@
 #include "services/planner/motion_planner.h"
 
 #include <algorithm>
-#include <functional>
 #include <chrono>
 #include <cmath>
+#include <functional>
 #include <memory>
 #include <random>
 #include <sstream>
