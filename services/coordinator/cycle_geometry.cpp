@@ -185,6 +185,10 @@ std::vector<Eigen::Isometry3d> holder_lift_moves(const Eigen::Isometry3d& s, dou
   return moves;
 }
 
+double next_lower_right_y(double right_y, double book_width, const CycleGeometry& g) {
+  return right_y - (book_width + g.lower_gap);
+}
+
 Eigen::Isometry3d lower_place_pose(const Eigen::Isometry3d& f, double right_y, double bw, double h,
                                    const CycleGeometry& g) {
   // The closed plates centre the book on the TCP: its right cover is BW/2 right of the TCP.

@@ -117,6 +117,9 @@ std::vector<Eigen::Isometry3d> holder_place_moves(const Eigen::Isometry3d& suppo
 /// The straight moves that lift a book grasped on the holder back to the pre-place pose (the reverse).
 std::vector<Eigen::Isometry3d> holder_lift_moves(const Eigen::Isometry3d& support, double tcp_height,
                                                  const CycleGeometry& g);
+/// The grasp Y of the next book's right cover on the lower shelf after a book `book_width` wide was placed with its
+/// right cover at `right_y` (`lower_gap` between them).
+double next_lower_right_y(double right_y, double book_width, const CycleGeometry& g);
 /// TCP pose that stands the held book on the lower shelf with its right cover at grasp Y `right_y`.
 Eigen::Isometry3d lower_place_pose(const Eigen::Isometry3d& grasp_frame, double right_y, double book_width,
                                    double tcp_height, const CycleGeometry& g);

@@ -580,7 +580,7 @@ void LibraryCycle::after_motion() {
       b.lower_right_y = progress_.lower_next_right_y;
       progress_.moved.push_back(b);
       progress_.books_moved += 1;
-      progress_.lower_next_right_y -= progress_.book_width + g.lower_gap;
+      progress_.lower_next_right_y = next_lower_right_y(progress_.lower_next_right_y, progress_.book_width, g);
       progress_.place = BookPlace::kUpperShelf;
       progress_.have_book_data = false;
       // Rule (a): the room left of this book, up to the shelf's left end, cannot hold an admissible book.

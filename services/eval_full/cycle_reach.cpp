@@ -48,7 +48,7 @@ std::vector<StageReach> cycle_reach(const scene::Scene& scene, const CycleGeomet
                              " books on the upper shelf, no book " + std::to_string(book_index));
   const scene::Book& book = scene.books[book_index];  // 0 = right-most at generation
   double lower_right_y = g.lower_first_right_y;
-  for (size_t i = 0; i < book_index; ++i) lower_right_y -= scene.books[i].width_m + g.lower_gap;
+  for (size_t i = 0; i < book_index; ++i) lower_right_y = next_lower_right_y(lower_right_y, scene.books[i].width_m, g);
   const Eigen::Isometry3d grasp = true_grasp_frame(scene);
   const Eigen::Isometry3d to_grasp = grasp.inverse();
   const Eigen::Vector3d p1 =

@@ -126,6 +126,12 @@ TEST(CycleGeometry, ExtractEndsAtTheSameHeightAndDepthWhereverItStarts) {
   EXPECT_NEAR((f.inverse() * extract_moves(tilted, f, tcp_height, grasp_z, g)[0].translation()).x(), 0.54, 1e-12);
 }
 
+TEST(CycleGeometry, TheNextLowerShelfSlotIsLeftOfTheBookAndTheGap) {
+  CycleGeometry g = geometry();
+  g.lower_gap = 0.003;
+  EXPECT_NEAR(next_lower_right_y(0.10, 0.02, g), 0.077, 1e-12);  // grasp Y grows to the right
+}
+
 TEST(CycleGeometry, ADiagonalLiftEndsOutAndUpInOneLineAndTheRetreatStaysWithin) {
   CycleGeometry g = geometry();
   g.extract_lift = 0.34;

@@ -36,6 +36,9 @@ class MotionPlannerTest : public ::testing::Test {
     start_ = q7(-1.0, 1.2, 0.0, 0.8, 0.0, 0.6, 0.0);
     goal_ = q7(1.0, 1.2, 0.0, 0.8, 0.0, 0.6, 0.0);
   }
+  /// The move to the book holder (below): a floor only, the start the IK of book_out_of_the_shelf(), the goal
+  /// the pose along_the_holders_plate(), a 3 s budget.
+  void shelf_to_holder_request(PlanRequest* req);
   PlannerSettings settings_;
   PlannerStack stack_;
   std::unique_ptr<PlanningScene> scene_;
@@ -186,26 +189,29 @@ Eigen::Isometry3d along_the_holders_plate() {
   return b;
 }
 
+void MotionPlannerTest::shelf_to_holder_request(PlanRequest* req) {
+  scene_->set_environment({box("floor", {0, 0, -0.6}, {3, 3, 0.1})});
+  const IkResult ia = stack_.ik.solve(book_out_of_the_shelf(), settings_.ik.preferred_posture);
+  ASSERT_TRUE(ia.success && scene_->is_valid(ia.q)) << ia.reason;
+  req->start = ia.q;
+  req->goal_is_pose = true;
+  req->goal_pose = along_the_holders_plate();
+  req->position_tolerance_m = 0.001;
+  req->orientation_tolerance_rad = 0.01;
+  req->time_budget_s = 3.0;
+}
+
 TEST_F(MotionPlannerTest, MaxToolTiltKeepsAHeldBookUprightAlongThePath) {
   // The move to the book holder (config/scenes/far_cart.yaml): from a gripper pointing forward over the cart
   // after the extraction to one pointing left and leaning 15 degrees along the holder's back plate. Every
   // state of the path and of the timed trajectory keeps the gripper's x (a held book's up) within 30
   // degrees of vertical; without the constraint the planner's path turned the book over (docs/EVALUATION.md).
-  scene_->set_environment({box("floor", {0, 0, -0.6}, {3, 3, 0.1})});
   const double max_tilt = 30.0 * M_PI / 180.0;
-  const Eigen::Isometry3d a = book_out_of_the_shelf(), b = along_the_holders_plate();
-  const IkResult ia = stack_.ik.solve(a, settings_.ik.preferred_posture);
-  ASSERT_TRUE(ia.success && scene_->is_valid(ia.q)) << ia.reason;
-  const IkResult ib = stack_.ik.solve(b, settings_.ik.preferred_posture);
-  ASSERT_TRUE(ib.success && scene_->is_valid(ib.q)) << ib.reason;
   PlanRequest req;
-  req.start = ia.q;
-  req.goal_is_pose = true;
-  req.goal_pose = b;
-  req.position_tolerance_m = 0.001;
-  req.orientation_tolerance_rad = 0.01;
+  ASSERT_NO_FATAL_FAILURE(shelf_to_holder_request(&req));
+  const IkResult ib = stack_.ik.solve(req.goal_pose, settings_.ik.preferred_posture);
+  ASSERT_TRUE(ib.success && scene_->is_valid(ib.q)) << ib.reason;
   req.max_tool_tilt_rad = max_tilt;
-  req.time_budget_s = 3.0;
   const auto tilt = [&](const Eigen::VectorXd& q) {
     return std::acos(std::clamp(stack_.kinematics.tip_pose(q).linear()(2, 0), -1.0, 1.0));
   };
@@ -231,18 +237,11 @@ TEST_F(MotionPlannerTest, APitchLimitKeepsTheApproachLevelAlongThePath) {
   // The same move as above (book out of the shelf -> along the holder's plate) with the gripper's z (the
   // approach, along which a held book creeps towards the plates' tips when it points down) kept within 8 deg
   // of horizontal at every state of the path and of the timed trajectory.
-  scene_->set_environment({box("floor", {0, 0, -0.6}, {3, 3, 0.1})});
   const double max_pitch = 8.0 * M_PI / 180.0;
-  const Eigen::Isometry3d a = book_out_of_the_shelf(), b = along_the_holders_plate();
-  const IkResult ia = stack_.ik.solve(a, settings_.ik.preferred_posture);
-  ASSERT_TRUE(ia.success && scene_->is_valid(ia.q)) << ia.reason;
   PlanRequest req;
-  req.start = ia.q;
-  req.goal_is_pose = true;
-  req.goal_pose = b;
+  ASSERT_NO_FATAL_FAILURE(shelf_to_holder_request(&req));
   req.max_tool_tilt_rad = 30.0 * M_PI / 180.0;
   req.max_tool_pitch_rad = max_pitch;
-  req.time_budget_s = 3.0;
   const auto pitch = [&](const Eigen::VectorXd& q) {
     return std::asin(std::min(1.0, std::abs(stack_.kinematics.tip_pose(q).linear()(2, 2))));
   };
@@ -255,7 +254,7 @@ TEST_F(MotionPlannerTest, APitchLimitKeepsTheApproachLevelAlongThePath) {
     EXPECT_LE(largest_along(r, pitch), max_pitch + 0.01);
   }
   // A goal whose approach points 20 deg down is refused, saying why; so is a bad limit.
-  const Eigen::Isometry3d down = b * Eigen::AngleAxisd(20.0 * M_PI / 180.0, Eigen::Vector3d::UnitY());
+  const Eigen::Isometry3d down = along_the_holders_plate() * Eigen::AngleAxisd(20.0 * M_PI / 180.0, Eigen::Vector3d::UnitY());
   req.goal_pose.linear() = down.linear();
   req.max_tool_tilt_rad = 0.0;
   const PlanOutcome refused = stack_.planner.plan(*scene_, req);
