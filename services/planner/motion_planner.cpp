@@ -250,7 +250,9 @@ PlanOutcome MotionPlanner::plan(const PlanningScene& scene, const PlanRequest& r
     }
     return scene.is_valid(q);
   };
-  // Start and goal must meet the orientation bounds the path keeps.
+  // Start and goal must meet the orientation bounds the path keeps. A goal outside them is a bad request; a start
+  // outside them is where the arm is (e.g. a restarted simulation put it back in its initial posture), like a start
+  // in collision: a planning failure, not a malformed message.
   const Eigen::Matrix3d goal_r = req.goal_is_pose ? Eigen::Matrix3d(req.goal_pose.linear())
                                                   : Eigen::Matrix3d(kin.tip_pose(req.goal_joints).linear());
   struct Bound {
@@ -267,7 +269,8 @@ PlanOutcome MotionPlanner::plan(const PlanningScene& scene, const PlanRequest& r
     for (const auto& [end_name, r] : {std::pair<const char*, Eigen::Matrix3d>{"start", start_tip.linear()},
                                       std::pair<const char*, Eigen::Matrix3d>{"goal", goal_r}})
       if (b.angle(r) > b.limit)
-        return fail(PlanFailure::kInvalidRequest, std::string("the ") + end_name + " " + b.what + " " +
+        return fail(std::string(end_name) == "start" ? PlanFailure::kStartInCollision : PlanFailure::kInvalidRequest,
+                    std::string("the ") + end_name + " " + b.what + " " +
                                                       fmt(b.angle(r)) + " rad from " + b.from + ", more than " +
                                                       b.key + " " + fmt(b.limit));
   }

@@ -23,7 +23,7 @@ namespace bookgrasp {
 enum class PlanFailure {
   kNone = 0,
   kInvalidRequest = 1,
-  kStartInCollision = 2,
+  kStartInCollision = 2,  ///< the start is no valid state: in collision, or outside the path's orientation bounds
   kGoalInCollision = 3,
   kNoIk = 4,
   kTimeout = 5,

@@ -231,6 +231,14 @@ TEST_F(MotionPlannerTest, MaxToolTiltKeepsAHeldBookUprightAlongThePath) {
   EXPECT_FALSE(refused.success);
   EXPECT_EQ(refused.failure, PlanFailure::kInvalidRequest);
   EXPECT_NE(refused.message.find("the goal tilts"), std::string::npos) << refused.message;
+  // A start leaning more than that (the arm where a restarted simulation put it) is a start-state failure, not a
+  // malformed request: the planner node does not count it as rejected input.
+  req.max_tool_tilt_rad = max_tilt;
+  req.start = q7(0.0, -M_PI / 2, 0.0, -M_PI / 2, 0.0, -M_PI / 2, 0.0);  // the scenes' initial posture, gripper down
+  const PlanOutcome from_down = stack_.planner.plan(*scene_, req);
+  EXPECT_FALSE(from_down.success);
+  EXPECT_EQ(from_down.failure, PlanFailure::kStartInCollision);
+  EXPECT_NE(from_down.message.find("the start tilts"), std::string::npos) << from_down.message;
 }
 
 TEST_F(MotionPlannerTest, APitchLimitKeepsTheApproachLevelAlongThePath) {
