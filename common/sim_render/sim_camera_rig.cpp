@@ -47,8 +47,10 @@ std::string check_sim_state(const sim_state_t& state) {
              std::to_string(arm.size()) + " arm joints)";
     }
   }
-  if (!finite(state.gripper_width_m) || state.gripper_width_m < -1e-3 || state.gripper_width_m > 0.1) {
-    return "gripper_width_m " + std::to_string(state.gripper_width_m) + " outside 0..0.1 m";
+  if (!finite(state.gripper_width_m) || state.gripper_width_m < kMinSimGripperWidthM ||
+      state.gripper_width_m > kMaxSimGripperWidthM) {
+    return "gripper_width_m " + std::to_string(state.gripper_width_m) + " outside " +
+           std::to_string(kMinSimGripperWidthM) + " .. " + std::to_string(kMaxSimGripperWidthM) + " m";
   }
   for (const auto& b : state.bodies) {
     double qn = 0.0;

@@ -69,10 +69,17 @@ class SimCameraRig {
   std::vector<int> owner_of_geom_;
 };
 
+/// The gripper widths a SIM_STATE may carry (m). A closed gripper reads below
+/// zero: the URDF lets each finger 1 mm past it and MuJoCo's joint limits and
+/// finger coupling are soft (CI saw -1.7 mm with the gripper closed).
+constexpr double kMinSimGripperWidthM = -0.005;
+constexpr double kMaxSimGripperWidthM = 0.1;  ///< see kMinSimGripperWidthM
+
 /// Checks a SIM_STATE before it is applied: array lengths agree with
 /// num_joints / num_bodies, every arm joint appears exactly once, all numbers
-/// are finite, quaternions are not zero. Returns "" if fine, otherwise the
-/// reason.
+/// are finite, the gripper width is within [kMinSimGripperWidthM,
+/// kMaxSimGripperWidthM], quaternions are not zero. Returns "" if fine,
+/// otherwise the reason.
 std::string check_sim_state(const sim_state_t& state);
 
 /// Whether a camera renders a SIM_STATE.

@@ -236,6 +236,15 @@ TEST(SimCameraRig, BadStatesAreRefusedWithAReason) {
   s.num_bodies += 2;
   EXPECT_NE(check_sim_state(s).find("num_bodies"), std::string::npos);
   s = good;
+  s.gripper_width_m = -0.0017;  // a closed gripper in CI (soft joint limits): not an error
+  EXPECT_EQ(check_sim_state(s), "");
+  s.gripper_width_m = -0.002;  // both fingers at the URDF's lower limit, -1 mm each
+  EXPECT_EQ(check_sim_state(s), "");
+  s.gripper_width_m = -0.006;
+  EXPECT_NE(check_sim_state(s).find("gripper_width_m"), std::string::npos);
+  s.gripper_width_m = 0.11;
+  EXPECT_NE(check_sim_state(s).find("gripper_width_m"), std::string::npos);
+  s = good;
   s.seed = 99;
   EXPECT_THROW(rig.apply(s), std::invalid_argument);
   EXPECT_THROW(rig.capture("no_camera", 0), std::invalid_argument);
