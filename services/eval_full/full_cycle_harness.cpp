@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <iostream>
 #include <regex>
+#include <set>
 #include <sstream>
 #include <stdexcept>
 
@@ -232,6 +233,7 @@ struct FullCycleHarness::Impl {
     t = t0;
     sim->advance_to(t);
     comp.spin();
+    if (o.verbose) touch_diag();
     truth = sim->world().model().ground_truth(t);
     for (const auto& b : truth.books)
       if (b.place == "upper_shelf") ++res.books_on_upper_shelf;
@@ -616,6 +618,36 @@ struct FullCycleHarness::Impl {
                   model.gripper_width(), dd->site_xmat[9 * site + 6], dd->site_xmat[9 * site + 7],
                   dd->site_xmat[9 * site + 8]);
     trace(l + contacts);
+  }
+
+  /// Verbose: a robot geom touching a book that the gripper is not meant to hold (every pair once per task
+  /// state entered): before the grasp any such touch is a collision, e.g. a servo pose's plates pushing the
+  /// right-most book over.
+  std::set<std::string> touches_seen;
+  std::string touches_state;
+  void touch_diag() {
+    if (status.state != touches_state) {
+      touches_state = status.state;
+      touches_seen.clear();
+    }
+    const auto& model = sim->world().model();
+    const mjModel* mm = model.model();
+    const mjData* dd = model.data();
+    for (int i = 0; i < dd->ncon; ++i) {
+      const mjContact& c = dd->contact[i];
+      int robot = c.geom1, book = c.geom2;
+      if (model.geom_owner_id(book) < 0) std::swap(robot, book);
+      const int b = model.geom_owner_id(book), r = model.geom_owner_id(robot);
+      if (b < 0 || (r != scene::kOwnerRobotArm && r != scene::kOwnerGripperFinger)) continue;
+      const bool holding = status.state != "SERVO_BOOK" && status.state != "MOVE_TO_BWH_START" &&
+                           status.state != "SERVO_STRIPE" && status.state != "MOVE_TO_STRIPE_START" &&
+                           status.state != "MOVE_TO_PRE_GRASP";
+      if (holding && b == target_book_id) continue;
+      const char* rn = mj_id2name(mm, mjOBJ_GEOM, robot);
+      const std::string key = std::string(rn ? rn : "?") + " book " + std::to_string(b);
+      if (!touches_seen.insert(key).second) continue;
+      trace("TOUCH_DIAG " + status.state + ": " + key + fmt(" (dist %.4f m)", c.dist));
+    }
   }
 
   int64_t last_periodic = 0;

@@ -22,7 +22,7 @@ CornerServoStep BookCornerServo::step(const Eigen::Vector2d& r_px, double slope_
                                       const Eigen::Vector3d& moved_since_capture) {
   CornerServoStep out;
   const CameraIntrinsics& k = geo_.intrinsics();
-  out.target_px = geo_.target_pixel(standoff_m);
+  out.target_px = geo_.target_pixel(standoff_m, p_.target_above_tcp_m);
   out.error_px = r_px - out.target_px;
   out.slope_error_rad = p_.align_slope ? slope_rad : 0.0;
 

@@ -3,7 +3,7 @@
 /// Image-based visual servoing on the book corner R (paper Section 2.2): one
 /// control step per BwH measurement. Drives R to the target pixel (the pixel at
 /// which a point straight ahead of the TCP appears at the requested standoff,
-/// HandEyeGeometry::target_pixel) and the book's image slope to zero, with a
+/// HandEyeGeometry::target_pixel, raised by target_above_tcp_m) and the book's image slope to zero, with a
 /// TCP twist in the gripper frame (vx = up, vy = right, wz = roll about the
 /// approach axis; vz and wx, wy stay zero so the standoff is kept).
 ///
@@ -31,6 +31,11 @@ struct BookCornerServoParams {
   bool compensate_capture_delay = true;  ///< the twist acts on the image's error plus what the TCP's motion since
                                          ///< the image was taken has moved R by (the corner is a fixed point);
                                          ///< false = on the image's error alone, which overshoots with late images
+  /// Not in the paper: R is driven to the pixel of the point this far above the TCP (gripper +x) at the standoff,
+  /// so the servo ends with the TCP this far below R, and P2 (ServoSession) is that pose raised by it. The hand
+  /// camera sits above the TCP: with 0, the nearer the standoff the lower R ends in the image, and at 9 cm it
+  /// ended ~26 px above the plates, too little of the fore-edge for BwH. 0 = the paper's (TCP axis through R).
+  double target_above_tcp_m = 0.0;
 };
 
 /// One control step.

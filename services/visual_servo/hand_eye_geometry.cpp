@@ -18,9 +18,9 @@ bool HandEyeGeometry::project_gripper_point(const Eigen::Vector3d& p_gripper, Ei
   return true;
 }
 
-Eigen::Vector2d HandEyeGeometry::target_pixel(double standoff_m) const {
+Eigen::Vector2d HandEyeGeometry::target_pixel(double standoff_m, double above_m) const {
   Eigen::Vector2d px(k_.cx, k_.cy);
-  project_gripper_point(Eigen::Vector3d(0, 0, standoff_m), &px);
+  project_gripper_point(Eigen::Vector3d(above_m, 0, standoff_m), &px);
   return px;
 }
 

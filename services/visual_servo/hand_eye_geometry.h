@@ -51,8 +51,9 @@ class HandEyeGeometry {
   /// The pixel at which a point straight ahead of the TCP (gripper frame
   /// (0, 0, standoff_m)) appears. Driving a feature to this pixel puts the TCP's
   /// approach axis through it: the TCP is then at the feature's up/right
-  /// coordinates, standoff_m in front of it.
-  Eigen::Vector2d target_pixel(double standoff_m) const;
+  /// coordinates, standoff_m in front of it. With `above_m` the point is
+  /// (above_m, 0, standoff_m): the feature then ends above_m above the TCP.
+  Eigen::Vector2d target_pixel(double standoff_m, double above_m = 0.0) const;
 
   /// Back-projects `pixel` onto the plane z_gripper = standoff_m (perpendicular
   /// to the approach axis). Returns false if the viewing ray does not hit the

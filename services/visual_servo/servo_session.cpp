@@ -255,7 +255,14 @@ SessionOutput ServoSession::on_book(const BookObservation& obs) {
     } else {
       message += "; R not triangulated: " + why;
     }
-    finish(ServoState::kConverged, message, &out, at_capture);
+    // P2: the pose with its TCP at R's height, i.e. the pose at capture raised by target_above_tcp_m.
+    std::optional<Eigen::Isometry3d> p2 = at_capture;
+    const double above = corner_.params().target_above_tcp_m;
+    if (p2 && above != 0.0) {
+      p2 = *p2 * Eigen::Translation3d(above, 0.0, 0.0);
+      message += fmt("; P2 is the TCP raised by %.1f mm (book_corner.target_above_tcp_m)", above * 1e3);
+    }
+    finish(ServoState::kConverged, message, &out, p2);
     if (!out.reports.empty()) out.reports.back().corner = corner;
     return out;
   }

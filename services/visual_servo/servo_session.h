@@ -99,7 +99,8 @@ struct ServoReport {
   int iterations = 0;
   Eigen::Vector2d error_px = Eigen::Vector2d::Zero();
   double slope_error_rad = 0;
-  std::optional<Eigen::Isometry3d> converged_pose;  ///< P2 or PS (CONVERGED only)
+  std::optional<Eigen::Isometry3d> converged_pose;  ///< P2 or PS (CONVERGED only); P2 is the TCP pose at the
+                                                    ///< last image raised by book_corner.target_above_tcp_m
   /// BOOK_CORNER CONVERGED only: R triangulated from the task's views, when they allowed it (else the
   /// message says why not).
   std::optional<TriangulatedCorner> corner;

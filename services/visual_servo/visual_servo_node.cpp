@@ -68,6 +68,7 @@ VisualServoSettings VisualServoSettings::from_config(const Config& root) {
   s.corner.converged_px = bc.get_double("converged_px", 0.01, 100);
   s.corner.converged_slope_rad = bc.get_double("converged_slope_deg", 0.01, 45) * M_PI / 180.0;
   s.corner.converged_frames = bc.get_int("converged_frames", 1, 1000);
+  s.corner.target_above_tcp_m = bc.get_double("target_above_tcp_m", -0.1, 0.1);
   s.corner.align_slope = bc.get<bool>("align_slope");
   s.corner.compensate_capture_delay = bc.get<bool>("compensate_capture_delay");
 

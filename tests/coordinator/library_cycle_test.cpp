@@ -186,14 +186,14 @@ TEST(LibraryCycle, ThreeBooksWholeCycleEveryTransitionAndPlacements) {
     EXPECT_NEAR(highest_place, 0.10, 0.01) << "the place starts at the descent's height";
   }
 
-  // The book-corner servo keeps the BwH start's distance to the books (TCP at Z = bwh_start_z_m, -0.10 in
+  // The book-corner servo keeps the BwH start's distance to the books (TCP at Z = bwh_start_z_m, -0.08 in
   // coordinator.yaml), so it never pulls the TCP towards the robot (the elbow's limit), and takes the corner on the
-  // book's front as BwS measured it: standoff = P1.z + 0.10 (the fake's P1.z is 0.012).
+  // book's front as BwS measured it: standoff = P1.z + 0.08 (the fake's P1.z is 0.012).
   int corner_requests = 0;
   for (const auto& q : w.requests)
     if (q.kind == CycleRequest::Kind::kServo && q.servo_mode == 1) {  // BOOK_CORNER (SERVO_REQUEST mode)
       ++corner_requests;
-      EXPECT_NEAR(q.fixed_depth, 0.112, 1e-12);
+      EXPECT_NEAR(q.fixed_depth, 0.092, 1e-12);
     }
   EXPECT_GE(corner_requests, 3);
 
@@ -253,11 +253,11 @@ TEST(LibraryCycle, AMissedGraspFromTheHolderBacksOutStraightBeforePlanning) {
 }
 
 TEST(LibraryCycle, TheArbitersFrontDepthSetsTheCornerServosStandoff) {
-  // coordinator.yaml: book_front_z_m 0.01 (when the arbiter gives no depth), bwh_start_z_m -0.10.
+  // coordinator.yaml: book_front_z_m 0.01 (when the arbiter gives no depth), bwh_start_z_m -0.08.
   const CycleSettings cs = settings();
   ASSERT_NEAR(cs.geometry.book_front_z, 0.01, 1e-12);
-  ASSERT_NEAR(cs.geometry.bwh_start_z, -0.10, 1e-12);
-  for (const auto& [front_z, standoff] : {std::pair{0.09, 0.19}, std::pair{double(NAN), 0.11}}) {
+  ASSERT_NEAR(cs.geometry.bwh_start_z, -0.08, 1e-12);
+  for (const auto& [front_z, standoff] : {std::pair{0.09, 0.17}, std::pair{double(NAN), 0.09}}) {
     FakeLibrary w(three_books());
     w.invalid_p1_front_z = front_z;  // 0.09: the target pushed 8 cm back; NaN: unknown, the model's plane
     LibraryCycle cycle(cs, std::nullopt);

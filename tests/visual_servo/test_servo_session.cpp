@@ -320,9 +320,11 @@ TEST(StripeServoLatency, ImagesASecondLateStillConvergeOnTheTrueEnd) {
 /// The corner servo with images `latency_s` late (run_with_late_images); the corner 4 cm up and 3 cm right of the
 /// start and `corner_z` ahead of it (the servo assumes 0.22 m), its top edge rolled 3 degrees. Returns the final
 /// report.
-ServoReport run_late_corner(double latency_s, bool compensate, double corner_z = 0.22) {
+ServoReport run_late_corner(double latency_s, bool compensate, double corner_z = 0.22, double target_above_m = 0.0,
+                            Eigen::Isometry3d* final_tcp = nullptr) {
   const HandEyeGeometry geo = test::project_geometry();
   BookCornerServoParams cp;
+  cp.target_above_tcp_m = target_above_m;
   cp.gain = 2.0;
   cp.slope_gain = 2.0;
   cp.max_linear_speed = 0.06;
@@ -346,9 +348,11 @@ ServoReport run_late_corner(double latency_s, bool compensate, double corner_z =
     o.found = scene.observe(geo, at, &o.r_px, &o.slope_rad);
     return o;
   };
-  return run_with_late_images(session, Eigen::Isometry3d::Identity(), r, latency_s, 2100, capture,
-                              [&](int64_t, const BookObservation& o) { return session.on_book(o); })
-      .first;
+  const auto [report, tcp] =
+      run_with_late_images(session, Eigen::Isometry3d::Identity(), r, latency_s, 2100, capture,
+                           [&](int64_t, const BookObservation& o) { return session.on_book(o); });
+  if (final_tcp) *final_tcp = tcp;
+  return report;
 }
 
 TEST(CornerServoLatency, ImagesASecondLateStillConvergeOnTheTrueCorner) {
@@ -361,6 +365,29 @@ TEST(CornerServoLatency, ImagesASecondLateStillConvergeOnTheTrueCorner) {
     EXPECT_NEAR(report.converged_pose->translation().y(), 0.03, 1.5e-3) << "latency " << latency;
   }
   EXPECT_NE(run_late_corner(1.0, false).state, ServoState::kConverged) << "the plant no longer shows the overshoot";
+}
+
+// Not in the paper: with book_corner.target_above_tcp_m the servo ends with the TCP that far below R (the camera,
+// 6 cm above the TCP, then sees R higher in its image), and P2 is that pose raised to R.
+TEST(CornerServoTargetAbove, TheTcpEndsBelowRAndP2IsAtR) {
+  for (const double above : {0.02, -0.01}) {
+    SCOPED_TRACE("target_above_tcp_m " + std::to_string(above));
+    Eigen::Isometry3d tcp = Eigen::Isometry3d::Identity();
+    const ServoReport report = run_late_corner(0.0, true, 0.22, above, &tcp);
+    ASSERT_EQ(report.state, ServoState::kConverged) << report.message;
+    ASSERT_TRUE(report.converged_pose.has_value());
+    const Eigen::Vector3d r_in_tcp = tcp.inverse() * Eigen::Vector3d(0.04, 0.03, 0.22);
+    EXPECT_NEAR(r_in_tcp.x(), above, 1.5e-3);  // the arm: `above` below R along its (rolled) x
+    EXPECT_NEAR(r_in_tcp.y(), 0.0, 1.5e-3);
+    EXPECT_NEAR(report.converged_pose->translation().x(), 0.04, 1.5e-3);  // P2: at R
+    EXPECT_NEAR(report.converged_pose->translation().y(), 0.03, 1.5e-3);
+    EXPECT_NEAR(report.converged_pose->translation().z(), tcp.translation().z(), 1e-9);  // the standoff kept
+    EXPECT_TRUE(report.converged_pose->linear().isApprox(tcp.linear(), 1e-3));
+    EXPECT_NE(report.message.find("P2 is the TCP raised by"), std::string::npos) << report.message;
+  }
+  // R's target pixel is higher in the image (smaller v) for a target above the TCP.
+  const HandEyeGeometry geo = test::project_geometry();
+  EXPECT_LT(geo.target_pixel(0.09, 0.02).y(), geo.target_pixel(0.09).y() - 20.0);
 }
 
 // Not in the paper: the converged report carries R located from the servo's views; it is right where the assumed
