@@ -222,6 +222,25 @@ void SimModel::set_arm_setpoint(const std::vector<double>& q) {
   for (size_t i = 0; i < q.size(); ++i) d_->ctrl[arm_act_[i]] = q[i];
 }
 
+void SimModel::move_book(int book_id, const Eigen::Isometry3d& pose) {
+  if (!pose.matrix().allFinite()) throw std::invalid_argument("move_book: the pose is not finite");
+  for (size_t k = 0; k < scene_->books.size(); ++k) {
+    if (scene_->books[k].id != book_id) continue;
+    mjtNum* q = d_->qpos + book_qpos_[k];
+    const Eigen::Quaterniond qu(pose.linear());
+    for (int j = 0; j < 3; ++j) q[j] = pose.translation()[j];
+    q[3] = qu.w();
+    q[4] = qu.x();
+    q[5] = qu.y();
+    q[6] = qu.z();
+    const int dof = m_->jnt_dofadr[m_->body_jntadr[book_body_[k]]];
+    std::fill(d_->qvel + dof, d_->qvel + dof + 6, 0.0);
+    mj_forward(m_, d_);
+    return;
+  }
+  throw std::invalid_argument("move_book: no book " + std::to_string(book_id) + " in the scene");
+}
+
 void SimModel::set_gripper_width(double w) {
   check_finite(w, "gripper width");
   gripper_target_ = std::clamp(w, 0.0, kGripperMax);

@@ -98,6 +98,10 @@ class SimModel {
   /// Ground truth from the current body poses (see ground_truth_t and docs/SCENE.md).
   ground_truth_t ground_truth(int64_t utime) const;
 
+  /// Puts book `book_id` at `pose` (base) at rest and nothing else (time, arm, gripper and the other books are
+  /// left as they are): a person moving a book, e.g. the librarian taking one off the holder. Throws
+  /// std::invalid_argument for an unknown id or a non-finite pose.
+  void move_book(int book_id, const Eigen::Isometry3d& pose);
   /// Runs `n` physics steps (with the arm's gravity compensation).
   void step(int n);
   /// Arm position setpoints (7 values, rad). Throws std::invalid_argument for a

@@ -106,10 +106,6 @@ BookDetection detect_books_page_faces(const cv::Mat& rgb, const PageFaceParams& 
       reject("does not reach down to the shelf (not a fore-edge: marker, backdrop, print)");
       continue;
     }
-    if (by <= p.top_margin_px) {
-      reject("touches the top border (no book top in view)");
-      continue;
-    }
     // Top-most pixel per column; runs of columns whose top edge is continuous.
     std::vector<int> top_of(static_cast<size_t>(bw), -1);
     for (int x = bx; x < bx + bw; ++x)
@@ -153,6 +149,12 @@ BookDetection detect_books_page_faces(const cv::Mat& rgb, const PageFaceParams& 
         last_reason = why;
         out.candidates.push_back(rc);
       };
+      // Per run, not per region: a fore-edge whose top is in view stays a candidate when it touches a taller
+      // neighbour's that runs out of the image (far_cart seed 6: one region, rejected whole, every other frame).
+      if (run_top <= p.top_margin_px) {
+        reject_run("touches the top border (no book top in view)");
+        continue;
+      }
       if (rc.height_px < p.min_height_px) {
         reject_run("lower than min_height_px");
         continue;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 
 #include "common/grasp_frame.h"
@@ -68,6 +69,7 @@ CycleGeometry CycleGeometry::from_config(const Config& c) {
   g.lower_place_guard = c.get_double("lower_shelf.place_guard_m", 0.0, 0.1);
   g.lower_shelf_gap = c.get_double("lower_shelf.gap_to_upper_shelf_m", 0.0, 1.5);
   g.held_top_above_tcp = c.get_double("lower_shelf.held_box_top_above_tcp_m", -0.2, 0.2);
+  g.lower_book_clearance = c.get_double("lower_shelf.book_clearance_m", 0.0, 0.5);
   g.place_clearance = c.get_double("place_clearance_m", 0.0, 0.05);
   return g;
 }
@@ -183,6 +185,11 @@ std::vector<Eigen::Isometry3d> holder_lift_moves(const Eigen::Isometry3d& s, dou
   moves.pop_back();  // from the place pose: up first (if a descent is configured), then to the pre-place pose
   moves.push_back(holder_pre_place_pose(s, h, g));
   return moves;
+}
+
+double lower_shelf_max_book_height(const CycleGeometry& g) {
+  if (g.lower_shelf_gap <= 0) return std::numeric_limits<double>::infinity();
+  return g.lower_shelf_gap - 2 * g.lower_book_clearance;
 }
 
 double next_lower_right_y(double right_y, double book_width, const CycleGeometry& g) {

@@ -68,6 +68,7 @@ struct CycleGeometry {
   double lower_retreat = 0.30;      ///< after release, out along -Z
   double lower_shelf_gap = 0.0;     ///< free height between the lower shelf and the upper one's underside (0 = unused)
   double held_top_above_tcp = 0.015;  ///< the planner's held-book box: its top above the TCP (planner.yaml)
+  double lower_book_clearance = 0.0;  ///< a book goes to the lower shelf only with this much room above and below it
   double place_clearance = 0.005;   ///< book bottom this far above a support when released
 
   /// Reads the `geometry:` section; throws ConfigError naming a bad key.
@@ -117,6 +118,8 @@ std::vector<Eigen::Isometry3d> holder_place_moves(const Eigen::Isometry3d& suppo
 /// The straight moves that lift a book grasped on the holder back to the pre-place pose (the reverse).
 std::vector<Eigen::Isometry3d> holder_lift_moves(const Eigen::Isometry3d& support, double tcp_height,
                                                  const CycleGeometry& g);
+/// The tallest book the lower shelf takes: `lower_shelf_gap` - 2 `lower_book_clearance` (infinite without a gap).
+double lower_shelf_max_book_height(const CycleGeometry& g);
 /// The grasp Y of the next book's right cover on the lower shelf after a book `book_width` wide was placed with its
 /// right cover at `right_y` (`lower_gap` between them).
 double next_lower_right_y(double right_y, double book_width, const CycleGeometry& g);

@@ -114,6 +114,8 @@ std::string cycle_state_name(CycleState s) {
       return "PARK_FOR_USER";
     case CycleState::kWaitUser:
       return "WAIT_USER";
+    case CycleState::kWaitBookTaken:
+      return "WAIT_BOOK_TAKEN";
     case CycleState::kMoveToHolderPreGrasp:
       return "MOVE_TO_HOLDER_PRE_GRASP";
     case CycleState::kOpenForHolderGrasp:
@@ -277,8 +279,8 @@ void LibraryCycle::check_timeout() {
             std::to_string(s_.markers_timeout_s) + " s (is marker_detector running, are the tags in view?)");
     return;
   }
-  if (state_ == CycleState::kWaitUser) {
-    abort("timeout in WAIT_USER: no \"done\" from the user within " + std::to_string(s_.user_timeout_s) + " s");
+  if (state_ == CycleState::kWaitUser || state_ == CycleState::kWaitBookTaken) {
+    abort("timeout in " + what + ": no \"done\" from the user within " + std::to_string(s_.user_timeout_s) + " s");
     return;
   }
   if (motion_.kind == MotionKind::kPlanned && motion_.planning) {
@@ -497,7 +499,6 @@ void LibraryCycle::motion_done() {
 
 // What follows each state once its motion (or wait) finished.
 void LibraryCycle::after_motion() {
-  const CycleGeometry& g = s_.geometry;
   switch (state_) {
     case CycleState::kBackOut:
       succeed(CycleState::kPark);
@@ -572,30 +573,10 @@ void LibraryCycle::after_motion() {
       if (book_lost_from_plates()) return;
       succeed(CycleState::kReleaseOnLowerShelf);
       return;
-    case CycleState::kReleaseOnLowerShelf: {
-      MovedBook b;
-      b.index = progress_.books_moved;
-      b.width = progress_.book_width;
-      b.gp_y = progress_.gp_grasp.y();
-      b.lower_right_y = progress_.lower_next_right_y;
-      progress_.moved.push_back(b);
-      progress_.books_moved += 1;
-      progress_.lower_next_right_y = next_lower_right_y(progress_.lower_next_right_y, progress_.book_width, g);
-      progress_.place = BookPlace::kUpperShelf;
-      progress_.have_book_data = false;
-      // Rule (a): the room left of this book, up to the shelf's left end, cannot hold an admissible book.
-      const double room = b.gp_y - b.width - g.shelf_left_y;
-      if (room < s_.s_min) {
-        progress_.finished = true;
-        message_ = "book " + std::to_string(b.index) + " on the lower shelf; upper shelf empty: " + mm(room) +
-                   " left of it < S_min " + mm(s_.s_min);
-      } else {
-        message_ = "book " + std::to_string(b.index) + " on the lower shelf";
-      }
-      attempt_ = 1;
+    case CycleState::kReleaseOnLowerShelf:
+      book_done(false);
       succeed(CycleState::kRetreatFromLowerShelf);
       return;
-    }
     case CycleState::kRetreatFromLowerShelf:
       succeed(CycleState::kPark);
       return;
@@ -605,6 +586,33 @@ void LibraryCycle::after_motion() {
 }
 
 // ---- transitions ----
+
+void LibraryCycle::book_done(bool handed_over) {
+  const CycleGeometry& g = s_.geometry;
+  MovedBook b;
+  b.index = progress_.books_moved;
+  b.width = progress_.book_width;
+  b.gp_y = progress_.gp_grasp.y();
+  b.lower_right_y = handed_over ? std::numeric_limits<double>::quiet_NaN() : progress_.lower_next_right_y;
+  b.handed_over = handed_over;
+  progress_.moved.push_back(b);
+  progress_.books_moved += 1;
+  if (!handed_over)
+    progress_.lower_next_right_y = next_lower_right_y(progress_.lower_next_right_y, progress_.book_width, g);
+  progress_.place = BookPlace::kUpperShelf;
+  progress_.have_book_data = false;
+  const std::string where = handed_over ? " taken off the holder by the librarian" : " on the lower shelf";
+  // Rule (a): the room left of this book, up to the shelf's left end, cannot hold an admissible book.
+  const double room = b.gp_y - b.width - g.shelf_left_y;
+  if (room < s_.s_min) {
+    progress_.finished = true;
+    message_ = "book " + std::to_string(b.index) + where + "; upper shelf empty: " + mm(room) + " left of it < S_min " +
+               mm(s_.s_min);
+  } else {
+    message_ = "book " + std::to_string(b.index) + where;
+  }
+  attempt_ = 1;
+}
 
 void LibraryCycle::succeed(CycleState next) {
   step_retries_ = 0;
@@ -741,7 +749,19 @@ void LibraryCycle::enter(CycleState s) {
       set_deadline(s_.user_timeout_s);
       message_ = "book " + std::to_string(progress_.books_moved) + " on the holder: waiting for the user's \"done\"";
       break;
+    case CycleState::kWaitBookTaken:
+      set_deadline(s_.user_timeout_s);
+      message_ = "book " + std::to_string(progress_.books_moved) + " is " + mm(held_box_height()) +
+                 " tall: the lower shelf takes books up to " + mm(lower_shelf_max_book_height(g)) +
+                 " (lower_shelf.gap_to_upper_shelf_m - 2 x book_clearance_m); it stays on the holder: take it off "
+                 "and send \"done\"";
+      break;
     case CycleState::kMoveToHolderPreGrasp:
+      // Every way to the grasp from the holder (the user's "done", a resumed task) passes here.
+      if (held_box_height() > lower_shelf_max_book_height(g)) {
+        enter(CycleState::kWaitBookTaken);
+        return;
+      }
       start_planned_pose(
           move_along_own_axes(holder_place_pose(holder_frame(), holder_regrasp_height(tcp_height(), g), g),
                               Eigen::Vector3d(0, 0, -g.holder_retreat)),
@@ -774,8 +794,12 @@ void LibraryCycle::enter(CycleState s) {
   }
   if (s == CycleState::kDone) {
     progress_.finished = true;
-    message_ = "upper shelf empty: " + std::to_string(progress_.books_moved) + " books moved" +
-               (message_.empty() ? "" : " (" + message_ + ")");
+    const auto handed =
+        std::count_if(progress_.moved.begin(), progress_.moved.end(), [](const MovedBook& b) { return b.handed_over; });
+    message_ =
+        "upper shelf empty: " + std::to_string(progress_.books_moved) + " books moved" +
+        (handed > 0 ? " (" + std::to_string(handed) + " of them too tall, left to the librarian on the holder)" : "") +
+        (message_.empty() ? "" : " (" + message_ + ")");
   }
   persist();
 }
@@ -1066,6 +1090,9 @@ std::vector<CycleRequest> LibraryCycle::on_user(const UserEvent& e) {
   } else if (e.event == "done" && state_ == CycleState::kWaitUser) {
     message_ = "user \"done\"" + (e.detail.empty() ? std::string("") : ": " + e.detail);
     succeed(CycleState::kMoveToHolderPreGrasp);
+  } else if (e.event == "done" && state_ == CycleState::kWaitBookTaken) {
+    book_done(true);
+    succeed(CycleState::kPark);
   }
   check_timeout();
   return out_;

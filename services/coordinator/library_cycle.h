@@ -206,6 +206,9 @@ enum class CycleState {
   kRetreatFromHolder,
   kParkForUser,
   kWaitUser,
+  /// Not in the paper: the book is taller than the lower shelf takes (lower_shelf_max_book_height): it stays on
+  /// the holder until the librarian takes it off and sends "done"; then the next book.
+  kWaitBookTaken,
   kMoveToHolderPreGrasp,
   kOpenForHolderGrasp,
   kApproachHolder,
@@ -301,6 +304,9 @@ class LibraryCycle {
   /// min_book_width), aborts naming the state ("book N is not in the gripper after STATE") and returns true.
   bool book_lost_from_plates();
   void motion_done();
+  /// The current book's cycle is over (on the lower shelf, or `handed_over` to the librarian): records it in the
+  /// progress, advances the lower shelf's next slot for a placed book, and decides whether the upper shelf is empty.
+  void book_done(bool handed_over);
   void after_motion();
   CycleState resume_target() const;
   void persist();

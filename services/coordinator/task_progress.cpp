@@ -62,7 +62,7 @@ std::string progress_to_yaml(const TaskProgress& p) {
   for (const MovedBook& b : p.moved)
     e << YAML::Flow << YAML::BeginMap << YAML::Key << "index" << YAML::Value << b.index << YAML::Key << "width"
       << YAML::Value << b.width << YAML::Key << "gp_y" << YAML::Value << b.gp_y << YAML::Key << "lower_right_y"
-      << YAML::Value << b.lower_right_y << YAML::EndMap;
+      << YAML::Value << b.lower_right_y << YAML::Key << "handed_over" << YAML::Value << b.handed_over << YAML::EndMap;
   e << YAML::EndSeq << YAML::EndMap;
   return std::string(e.c_str()) + "\n";
 }
@@ -95,6 +95,7 @@ TaskProgress progress_from_yaml(const std::string& text, const std::string& sour
     m.width = need<double>(b, "width", source);
     m.gp_y = need<double>(b, "gp_y", source);
     m.lower_right_y = need<double>(b, "lower_right_y", source);
+    m.handed_over = b["handed_over"] ? need<bool>(b, "handed_over", source) : false;  // absent before stop 22
     p.moved.push_back(m);
   }
   if (p.books_moved < 0 || p.books_moved != static_cast<int>(p.moved.size()))

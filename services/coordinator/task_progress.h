@@ -30,12 +30,14 @@ struct MovedBook {
   int index = 0;              ///< 0 = first book taken
   double width = 0;           ///< from the gripper plates, m
   double gp_y = 0;            ///< grasp-frame Y of its GP (its right cover on the upper shelf), m
-  double lower_right_y = 0;   ///< grasp-frame Y of its right cover on the lower shelf, m
+  double lower_right_y = 0;   ///< grasp-frame Y of its right cover on the lower shelf, m (handed over: NaN)
+  /// Too tall for the lower shelf: left on the holder and taken off it by the librarian (WAIT_BOOK_TAKEN).
+  bool handed_over = false;
 };
 
 /// Everything persisted.
 struct TaskProgress {
-  int books_moved = 0;                    ///< completed cycles
+  int books_moved = 0;                    ///< completed cycles (lower shelf, or handed over: MovedBook)
   int failures = 0;                       ///< failures (each retried or aborting), all books
   BookPlace place = BookPlace::kUpperShelf;  ///< where the current book is
   bool have_book_data = false;            ///< gp_grasp and book_width below are set

@@ -58,7 +58,8 @@ std::string failure_reason(const FullCycleResult& r, int max_books) {
     if (b.standing_on_holder == 0) return "BOOK_NOT_STANDING_ON_HOLDER after RETREAT_FROM_HOLDER";
   for (const auto& b : r.books) {
     const std::string place = final_place(r, b);
-    if (b.moved && place != "lower_shelf") return "BOOK_NOT_ON_LOWER_SHELF at the end: the book is " + place;
+    if (b.moved && !b.handed_over && place != "lower_shelf")
+      return "BOOK_NOT_ON_LOWER_SHELF at the end: the book is " + place;
   }
   if (r.end == "ABORTED") {
     // "aborted in STATE: book 0: 3 attempts failed (...), last: <cause>": class = state + cause.
@@ -87,13 +88,18 @@ std::string failure_reason(const FullCycleResult& r, int max_books) {
     // Every upper-shelf book should have gone to the lower shelf.
     int left_upper = 0, elsewhere = 0;
     for (const auto& b : r.final_truth.books) {
+      const bool handed = std::any_of(r.books.begin(), r.books.end(),
+                                      [&](const BookRecord& k) { return k.handed_over && k.truth_id == b.id; });
       if (b.place == "upper_shelf") ++left_upper;
-      if (b.place != "upper_shelf" && b.place != "lower_shelf") ++elsewhere;
+      if (b.place != "upper_shelf" && b.place != "lower_shelf" && !handed) ++elsewhere;
     }
     if (elsewhere > 0) return "DONE with " + std::to_string(elsewhere) + " book(s) neither on a shelf";
     if (left_upper > 0) return "DONE with " + std::to_string(left_upper) + " book(s) left on the upper shelf";
   }
   if (r.grasp_attempts > r.grasp_successes) return "GRASP_RETRIED: a grasp did not hold the book";
+  for (const auto& b : r.books)
+    if (b.handed_over)
+      return "HANDED_OVER: a book too tall for the lower shelf was left on the holder for the librarian";
   return "";
 }
 
@@ -106,6 +112,7 @@ void accumulate(const SceneOutcome& o, int max_books, const MetricTolerances& to
   // A book counts as moved when the coordinator says so and the simulation's truth has it on the lower shelf.
   const int moved = books_on_lower_shelf(r);
   m->books_moved += std::min(moved, targeted > 0 ? targeted : moved);
+  for (const auto& b : r.books) m->books_handed_over += b.handed_over ? 1 : 0;
   m->grasp_attempts += r.grasp_attempts;
   m->grasp_successes += r.grasp_successes;
   m->holder_releases += r.holder_releases;
@@ -191,6 +198,7 @@ std::string metrics_json(const EvalMetrics& m, const std::string& command) {
   j << "  \"books_targeted\": " << m.books_targeted << ",\n";
   j << "  \"books_moved\": " << m.books_moved << ",\n";
   j << "  \"books_moved_rate\": " << rate(m.books_moved, m.books_targeted) << ",\n";
+  j << "  \"books_handed_over\": " << m.books_handed_over << ",\n";
   j << "  \"grasp_attempts\": " << m.grasp_attempts << ",\n";
   j << "  \"grasp_successes\": " << m.grasp_successes << ",\n";
   j << "  \"grasp_success_rate\": " << rate(m.grasp_successes, m.grasp_attempts) << ",\n";

@@ -79,6 +79,7 @@ class FakeLibrary {
   int missed_holder_grasps = 0;              ///< ... on the holder (the book stays there)
   bool servo_silent = false;                 ///< servo never answers (timeouts)
   bool user_answers = true;                  ///< sends "done" in WAIT_USER after 1 s
+  bool librarian_answers = true;             ///< in WAIT_BOOK_TAKEN: takes the book off the holder, "done" after 1 s
   int arm_moves_during_planning = 0;         ///< the next N plans: the joints move 0.05 rad before the answer
   int coast_after_servo_ticks = 0;           ///< after each servo answer the arm still EXECUTES this many ticks
   /// State name -> base z the TCP cannot go below in that state's straight moves (the held book stands on its
@@ -95,6 +96,7 @@ class FakeLibrary {
   std::vector<std::pair<FakeBook, Eigen::Isometry3d>> lower;       ///< book, TCP at release
   std::vector<std::pair<FakeBook, Eigen::Isometry3d>> holder_drops;  ///< book, TCP at release on the holder
   std::vector<std::pair<FakeBook, Eigen::Isometry3d>> holder_grasps;  ///< book, TCP at the grasp from the holder
+  std::vector<FakeBook> taken_by_librarian;                           ///< books taken off the holder in WAIT_BOOK_TAKEN
   Eigen::Isometry3d ee = Eigen::Isometry3d::Identity();
   Eigen::Isometry3d park_pose;
   double width = 0.06;
@@ -142,9 +144,14 @@ class FakeLibrary {
     // The arbiter answers each stereo frame (5 Hz) while the cycle waits for a P1 check.
     if (cycle.state() == bookgrasp::CycleState::kWaitP1Check && (t / 10000) % 20 == 0)
       handle(cycle, cycle.on_decision(p1_check(0)));
-    if (cycle.state() == bookgrasp::CycleState::kWaitUser && user_answers) {
+    const bool librarian = cycle.state() == bookgrasp::CycleState::kWaitBookTaken && librarian_answers;
+    if ((cycle.state() == bookgrasp::CycleState::kWaitUser && user_answers) || librarian) {
       if (wait_user_since_ < 0) wait_user_since_ = t;
       if (t - wait_user_since_ >= 1000000) {
+        if (librarian && on_holder) {
+          taken_by_librarian.push_back(*on_holder);
+          on_holder.reset();
+        }
         bookgrasp::UserEvent u;
         u.utime = t;
         u.event = "done";

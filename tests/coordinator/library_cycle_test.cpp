@@ -7,9 +7,11 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <functional>
+#include <limits>
 #include <sstream>
 #include <string>
 #include <tuple>
@@ -206,6 +208,49 @@ TEST(LibraryCycle, ThreeBooksWholeCycleEveryTransitionAndPlacements) {
     }
   }
   EXPECT_GT(heartbeats, 0);
+}
+
+// Not in the paper: a book taller than the lower shelf takes (coordinator.yaml: 0.30 - 2 x 0.013 = 0.274 m) is not
+// taken off the holder; the librarian takes it, says "done", and the cycle goes on with the next book.
+TEST(LibraryCycle, ABookTooTallForTheLowerShelfStaysOnTheHolderForTheLibrarian) {
+  const CycleSettings cs = settings();
+  ASSERT_NEAR(bookgrasp::lower_shelf_max_book_height(cs.geometry), 0.274, 1e-9);
+  FakeLibrary w({{0, 0.025, 0.29, 0.300}, {1, 0.020, 0.18, 0.273}, {2, 0.030, 0.27, 0.251}});
+  LibraryCycle cycle(cs, std::nullopt);
+  std::string waiting_message;
+  w.run(cycle, [&] {
+    if (cycle.state() == CycleState::kWaitBookTaken) waiting_message = cycle.status().message;
+    return done_or_aborted(cycle);
+  });
+  ASSERT_EQ(cycle.state(), CycleState::kDone) << cycle.status().message;
+  ASSERT_EQ(w.taken_by_librarian.size(), 1u);
+  EXPECT_EQ(w.taken_by_librarian[0].id, 0);
+  ASSERT_EQ(w.lower.size(), 2u);  // the 0.27 m book fits
+  EXPECT_EQ(w.lower[0].first.id, 1);
+  EXPECT_EQ(w.lower[1].first.id, 2);
+  EXPECT_EQ(count(w.states, "WAIT_BOOK_TAKEN"), 1);
+  EXPECT_EQ(w.holder_grasps.size(), 2u) << "the tall book is never taken off the holder by the robot";
+  EXPECT_NE(waiting_message.find("290.0 mm tall"), std::string::npos) << waiting_message;
+  EXPECT_NE(waiting_message.find("take it off"), std::string::npos) << waiting_message;
+  // The progress: three books done, the first handed over; the lower shelf's first slot went to book 1.
+  ASSERT_EQ(cycle.progress().moved.size(), 3u);
+  EXPECT_TRUE(cycle.progress().moved[0].handed_over);
+  EXPECT_TRUE(std::isnan(cycle.progress().moved[0].lower_right_y));
+  EXPECT_FALSE(cycle.progress().moved[1].handed_over);
+  EXPECT_NEAR(cycle.progress().moved[1].lower_right_y, cs.geometry.lower_first_right_y, 1e-12);
+  EXPECT_NE(cycle.status().message.find("1 of them too tall"), std::string::npos) << cycle.status().message;
+}
+
+TEST(LibraryCycle, WithoutTheLibrarianTheTallBookWaitsOnTheHolder) {
+  FakeLibrary w({{0, 0.025, 0.29, 0.300}, {1, 0.020, 0.18, 0.273}});
+  w.librarian_answers = false;
+  LibraryCycle cycle(settings(), std::nullopt);
+  w.run(
+      cycle, [&] { return done_or_aborted(cycle); }, 60000);  // 10 min of message time
+  EXPECT_EQ(cycle.state(), CycleState::kWaitBookTaken) << cycle.status().message;
+  EXPECT_TRUE(w.on_holder.has_value());
+  EXPECT_EQ(cycle.progress().place, BookPlace::kOnHolder);
+  EXPECT_TRUE(w.lower.empty());
 }
 
 TEST(LibraryCycle, RetriesNextRegionNoGraspMissedGraspAndPlanFailure) {
@@ -685,13 +730,26 @@ TEST(TaskProgress, RoundTripAndCorruptFilesAreNamed) {
   p.lower_next_right_y = 0.34;
   p.last_state = "WAIT_USER";
   p.moved.push_back({0, 0.02, 0.31, 0.37});
+  p.moved.push_back({1, 0.03, 0.28, std::numeric_limits<double>::quiet_NaN(), true});  // handed over
+  p.books_moved = 2;
   const auto q = bookgrasp::progress_from_yaml(bookgrasp::progress_to_yaml(p), "test");
-  EXPECT_EQ(q.books_moved, 1);
+  EXPECT_EQ(q.books_moved, 2);
+  ASSERT_EQ(q.moved.size(), 2u);
+  EXPECT_FALSE(q.moved[0].handed_over);
+  EXPECT_TRUE(q.moved[1].handed_over);
+  EXPECT_TRUE(std::isnan(q.moved[1].lower_right_y));
+  // A file written before the key existed: not handed over.
+  const auto old = bookgrasp::progress_from_yaml(
+      "books_moved: 1\nfailures: 0\nplace: upper_shelf\nhave_book_data: false\ngp_grasp: [0, 0, 0]\nbook_width: 0\n"
+      "lower_next_right_y: 0\nfinished: false\nlast_state: PARK\n"
+      "moved: [{index: 0, width: 0.02, gp_y: 0.3, lower_right_y: 0.38}]\n",
+      "old.yaml");
+  ASSERT_EQ(old.moved.size(), 1u);
+  EXPECT_FALSE(old.moved[0].handed_over);
   EXPECT_EQ(q.place, BookPlace::kOnHolder);
   EXPECT_EQ(q.gp_grasp, p.gp_grasp);
   EXPECT_EQ(q.book_width, 0.025);
   EXPECT_EQ(q.last_state, "WAIT_USER");
-  ASSERT_EQ(q.moved.size(), 1u);
   EXPECT_EQ(q.moved[0].lower_right_y, 0.37);
   EXPECT_THROW(bookgrasp::progress_from_yaml("books_moved: 1\n", "x"), std::runtime_error);
   try {

@@ -131,6 +131,25 @@ TEST(FullCycleMetrics, AMovedBookCountsOnlyIfTheTruthHasItOnTheLowerShelf) {
   EXPECT_EQ(m.failures[0].second, "BOOK_NOT_ON_LOWER_SHELF at the end: the book is other");
 }
 
+TEST(FullCycleMetrics, AHandedOverBookIsCountedApartAndNamedOnlyWhenNothingElseFailed) {
+  // The first book was too tall for the lower shelf: the librarian took it (truth: "other"); the second was moved.
+  SceneOutcome o = done_scene(5);
+  o.result.final_truth.books[0].place = "other";
+  o.result.books[0].handed_over = true;
+  o.result.grasp_attempts = o.result.grasp_successes = 2;
+  EXPECT_EQ(books_on_lower_shelf(o.result), 1);
+  EXPECT_EQ(failure_reason(o.result, 0),
+            "HANDED_OVER: a book too tall for the lower shelf was left on the holder for the librarian");
+  EvalMetrics m;
+  accumulate(o, 0, MetricTolerances{}, &m);
+  EXPECT_EQ(m.books_moved, 1);
+  EXPECT_EQ(m.books_handed_over, 1);
+  EXPECT_NE(metrics_json(m, "cmd").find("\"books_handed_over\": 1"), std::string::npos);
+  // A book that fell is still named first.
+  o.result.final_truth.books[1].place = "other";
+  EXPECT_EQ(failure_reason(o.result, 0), "BOOK_NOT_ON_LOWER_SHELF at the end: the book is other");
+}
+
 TEST(FullCycleMetrics, FailureReasons) {
   FullCycleResult r;
   r.end = "ERROR";

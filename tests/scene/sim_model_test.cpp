@@ -152,6 +152,34 @@ TEST(SimModel, ApplyRestoresAState) {
   EXPECT_THROW(b.apply(bad), std::invalid_argument);
 }
 
+TEST(SimModel, MoveBookPutsOneBookAtRestAndLeavesEverythingElse) {
+  const Scene s = load_scene(kScene, 4);
+  SimModel sm = SimModel::build(s);
+  sm.step(10);
+  const double t0 = sm.sim_time();
+  const sim_state_t before = sm.state(0);
+  const int id = s.books.front().id;
+  sm.move_book(id, Eigen::Isometry3d(Eigen::Translation3d(-2.0, 1.0, s.floor_z + 0.2)));
+  EXPECT_DOUBLE_EQ(sm.sim_time(), t0);
+  sm.step(1000);  // 2 s: it falls 0.2 m minus half its size onto the floor and stays there
+  const ground_truth_t g = sm.ground_truth(0);
+  const sim_state_t after = sm.state(0);
+  for (const auto& b : g.books) {
+    if (b.id == id) {
+      EXPECT_EQ(b.place, "other");
+      EXPECT_NEAR(b.pose.position[0], -2.0, 0.05);
+      EXPECT_NEAR(b.pose.position[1], 1.0, 0.05);
+    } else {
+      EXPECT_EQ(b.place, "upper_shelf") << "book " << b.id;
+    }
+  }
+  for (int i = 0; i < 7; ++i) EXPECT_NEAR(after.joint_positions[i], before.joint_positions[i], 1e-3);
+  EXPECT_THROW(sm.move_book(9999, Eigen::Isometry3d::Identity()), std::invalid_argument);
+  Eigen::Isometry3d nan_pose = Eigen::Isometry3d::Identity();
+  nan_pose.translation().x() = std::nan("");
+  EXPECT_THROW(sm.move_book(id, nan_pose), std::invalid_argument);
+}
+
 TEST(SimModel, RejectsBadArmSetpoints) {
   SimModel sm = SimModel::build(load_scene(kScene, 1));
   EXPECT_THROW(sm.set_arm_setpoint({0, 0, 0}), std::invalid_argument);
