@@ -26,6 +26,8 @@ std::string task_end_name(TaskEnd e) {
       return "ABORTED";
     case TaskEnd::kEnoughBooks:
       return "ENOUGH_BOOKS";
+    case TaskEnd::kWaitingForLibrarian:
+      return "WAITING_FOR_LIBRARIAN";
   }
   return "?";
 }
@@ -54,11 +56,14 @@ std::vector<std::string> TaskRunLog::on_status(const task_status_t& s) {
     MovedBook b;
     b.index = books_moved_;
     b.cycle_s = static_cast<double>(last_utime_ - book_start_utime_) * 1e-6;
+    b.handed_over = state_ == "WAIT_BOOK_TAKEN";  // the count went up when the librarian said "done"
     moved_.push_back(b);
     ++books_moved_;
     book_start_utime_ = last_utime_;
-    lines.push_back(t + "book " + std::to_string(b.index + 1) + " moved to the lower shelf (cycle " +
-                    seconds(b.cycle_s) + ")");
+    lines.push_back(t + "book " + std::to_string(b.index + 1) +
+                    (b.handed_over ? " taken off the holder by the librarian (too tall for the lower shelf)"
+                                   : " moved to the lower shelf") +
+                    " (cycle " + seconds(b.cycle_s) + ")");
   }
   if (s.failures > failures_count_) {
     failures_count_ = s.failures;
@@ -80,6 +85,8 @@ std::vector<std::string> TaskRunLog::on_status(const task_status_t& s) {
     end_ = TaskEnd::kAborted;
   } else if (stop_after_books_ > 0 && static_cast<int>(moved_.size()) >= stop_after_books_) {
     end_ = TaskEnd::kEnoughBooks;
+  } else if (stop_at_librarian_ && s.state == "WAIT_BOOK_TAKEN") {
+    end_ = TaskEnd::kWaitingForLibrarian;
   }
   return lines;
 }
@@ -88,7 +95,10 @@ std::string TaskRunLog::summary() const {
   std::ostringstream o;
   o << "task: " << (first_utime_ < 0 ? "no TASK_STATUS received" : task_end_name(end_)) << " after "
     << seconds(elapsed_s()) << " of message time, last state " << (state_.empty() ? "-" : state_) << "\n";
-  o << "books moved (holder and back to the lower shelf): " << books_moved_;
+  if (end_ == TaskEnd::kWaitingForLibrarian) o << "waiting for the librarian: " << last_message_ << "\n";
+  const auto handed = std::count_if(moved_.begin(), moved_.end(), [](const MovedBook& b) { return b.handed_over; });
+  o << "books moved (holder and back to the lower shelf): " << books_moved_ - handed;
+  if (handed > 0) o << "; handed to the librarian (too tall for the lower shelf): " << handed;
   if (!moved_.empty()) {
     std::vector<double> c;
     for (const auto& b : moved_) c.push_back(b.cycle_s);

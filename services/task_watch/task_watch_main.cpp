@@ -17,14 +17,17 @@ void help() {
                "  --books K     stop following once K books went through the whole cycle (default 0: until\n"
                "                the coordinator reports DONE or ABORTED)\n"
                "  --timeout S   give up after S seconds of wall time (default 0: never)\n"
+               "  --stop-at-librarian  stop when the task waits for the librarian to take a book too tall for\n"
+               "                the lower shelf off the holder (WAIT_BOOK_TAKEN): a demo with nobody to do it\n"
                "Exit code: 0 DONE or K books moved, 1 ABORTED, 4 timeout or Ctrl-C while running,\n"
-               "5 no TASK_STATUS at all, 2 bad command line, 3 no bus.\n";
+               "5 no TASK_STATUS at all, 6 waiting for the librarian (--stop-at-librarian), 2 bad command\n"
+               "line, 3 no bus.\n";
 }
 
 struct Listener {
   bookgrasp::TaskRunLog log;
   bool any = false;
-  explicit Listener(int books) : log(books) {}
+  Listener(int books, bool stop_at_librarian) : log(books, stop_at_librarian) {}
   void on(const lcm::ReceiveBuffer*, const std::string&, const bookgrasp::task_status_t* m) {
     any = true;
     for (const auto& line : log.on_status(*m)) std::cout << line << "\n" << std::flush;
@@ -37,6 +40,7 @@ int main(int argc, char** argv) {
   std::string url_arg, channel = "TASK_STATUS";
   int books = 0;
   double timeout_s = 0;
+  bool stop_at_librarian = false;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     auto value = [&]() -> std::string {
@@ -56,6 +60,8 @@ int main(int argc, char** argv) {
         channel = value();
       } else if (a == "--books") {
         books = std::stoi(value());
+      } else if (a == "--stop-at-librarian") {
+        stop_at_librarian = true;
       } else if (a == "--timeout") {
         timeout_s = std::stod(value());
       } else {
@@ -78,7 +84,7 @@ int main(int argc, char** argv) {
   }
   bookgrasp::install_stop_signals();
 
-  Listener listener(books);
+  Listener listener(books, stop_at_librarian);
   lcm.subscribe(channel, &Listener::on, &listener);
   // Wall time only bounds how long a person waits; the task's own times are message time.
   const bookgrasp::WallTimeSource wall;
@@ -97,6 +103,8 @@ int main(int argc, char** argv) {
       return 0;
     case bookgrasp::TaskEnd::kAborted:
       return 1;
+    case bookgrasp::TaskEnd::kWaitingForLibrarian:
+      return 6;
     case bookgrasp::TaskEnd::kRunning:
       break;
   }

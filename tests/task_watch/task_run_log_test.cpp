@@ -50,6 +50,37 @@ TEST(TaskRunLog, BooksMovedWithCycleTimesUntilDone) {
   EXPECT_NE(s.find("failures: 0"), std::string::npos) << s;
 }
 
+TEST(TaskRunLog, ABookHandedToTheLibrarianIsNotCountedAsOnTheLowerShelf) {
+  TaskRunLog log;
+  log.on_status(st(0, "START", 0));
+  log.on_status(st(50, "WAIT_USER", 0));
+  log.on_status(st(60, "WAIT_BOOK_TAKEN", 0, 0, "book 0 is 290.0 mm tall: ... take it off and send \"done\""));
+  EXPECT_TRUE(contains(log.on_status(st(90, "PARK", 1)),
+                       "book 1 taken off the holder by the librarian (too tall for the lower shelf) (cycle 90.0 s)"));
+  log.on_status(st(150, "WAIT_USER", 1));
+  EXPECT_TRUE(contains(log.on_status(st(200, "PARK", 2)), "book 2 moved to the lower shelf (cycle 110.0 s)"));
+  log.on_status(st(210, "DONE", 2));
+  ASSERT_EQ(log.moved().size(), 2u);
+  EXPECT_TRUE(log.moved()[0].handed_over);
+  EXPECT_FALSE(log.moved()[1].handed_over);
+  const std::string s = log.summary();
+  EXPECT_NE(s.find("books moved (holder and back to the lower shelf): 1; handed to the librarian (too tall for the "
+                   "lower shelf): 1"),
+            std::string::npos)
+      << s;
+}
+
+TEST(TaskRunLog, StopsAtTheLibrarianOnlyWhenAsked) {
+  TaskRunLog follow;
+  follow.on_status(st(60, "WAIT_BOOK_TAKEN", 0, 0, "book 0 is 290.0 mm tall"));
+  EXPECT_EQ(follow.end(), TaskEnd::kRunning);
+  TaskRunLog demo(0, true);
+  demo.on_status(st(60, "WAIT_BOOK_TAKEN", 0, 0, "book 0 is 290.0 mm tall"));
+  EXPECT_EQ(demo.end(), TaskEnd::kWaitingForLibrarian);
+  EXPECT_NE(demo.summary().find("waiting for the librarian: book 0 is 290.0 mm tall"), std::string::npos)
+      << demo.summary();
+}
+
 TEST(TaskRunLog, FailuresAndAbortAreListedOnceWithReasons) {
   TaskRunLog log;
   log.on_status(st(0, "SERVO_STRIPE", 0));
