@@ -25,7 +25,6 @@
 #include "bookgrasp/servo_status_t.hpp"
 #include "bookgrasp/stereo_frame_t.hpp"
 #include "bookgrasp/stripe_features_t.hpp"
-#include "bookgrasp/user_event_t.hpp"
 #include "common/composition.h"
 #include "common/config.h"
 #include "common/image_conversion.h"
@@ -130,7 +129,6 @@ struct FullCycleHarness::Impl {
   std::string ch_status = "TASK_STATUS", ch_gp = "GRASP_POINT", ch_truth = "SIM_GROUND_TRUTH",
               ch_stereo = "STEREO_IMAGES", ch_hand = "HAND_IMAGE", ch_plan = "PLAN_RESULT", ch_markers = "MARKERS";
   std::string marker_roles = "-";
-  std::string ch_user = "USER_EVENT";
   std::string ch_servo = "SERVO_STATUS", ch_stripe = "STRIPE_FEATURES_HAND", ch_book = "BOOK_FEATURES_HAND";
   std::string last_gp_reason, last_servo_line, last_stripe_line, last_book_line;
   int64_t last_servo_trace = 0;
@@ -201,7 +199,6 @@ struct FullCycleHarness::Impl {
     ch_status = coord_y.root["channels"]["task_status"].as<std::string>();
     ch_markers = coord_y.root["channels"]["markers"].as<std::string>();
     ch_servo = coord_y.root["channels"]["servo_status"].as<std::string>();
-    ch_user = coord_y.root["channels"]["user_event"].as<std::string>();
     ch_gp = coord_y.root["channels"]["grasp_point"].as<std::string>();
     coord_y.apply("coordinator", o.overrides);
     coordinator_yaml_path = coord_y.path;
@@ -237,7 +234,6 @@ struct FullCycleHarness::Impl {
     sim->advance_to(t);
     comp.spin();
     if (o.verbose) touch_diag();
-    librarian();
     truth = sim->world().model().ground_truth(t);
     for (const auto& b : truth.books)
       if (b.place == "upper_shelf") ++res.books_on_upper_shelf;
@@ -386,6 +382,8 @@ struct FullCycleHarness::Impl {
     const std::string prev = status.state;
     const int prev_moved = status.books_moved;
     status = *m;
+    // sim_world's librarian took a book too tall for the lower shelf off the holder: its "done" ended the cycle.
+    if (prev == "WAIT_BOOK_TAKEN" && m->books_moved > prev_moved) book(prev_moved).handed_over = true;
     if (m->books_moved > prev_moved) {
       for (int i = prev_moved; i < m->books_moved; ++i) {
         BookRecord& b = book(i);
@@ -652,35 +650,6 @@ struct FullCycleHarness::Impl {
       if (!touches_seen.insert(key).second) continue;
       trace("TOUCH_DIAG " + status.state + ": " + key + fmt(" (dist %.4f m)", c.dist));
     }
-  }
-
-  /// The librarian: a book the coordinator leaves on the holder (WAIT_BOOK_TAKEN) is taken out of the scene (put on
-  /// the floor 2 m behind the robot) 1 s after, and "done" goes to the coordinator on USER_EVENT.
-  int64_t book_taken_since = -1;
-  void librarian() {
-    if (status.state != "WAIT_BOOK_TAKEN") {
-      book_taken_since = -1;
-      return;
-    }
-    if (book_taken_since < 0) book_taken_since = t;
-    if (book_taken_since == 0 || t - book_taken_since < 1000000) return;
-    book_taken_since = 0;  // once per visit
-    auto& model = sim->world().model();
-    const int64_t now = sim->world().now_utime();
-    std::string taken;
-    for (const auto& b : model.ground_truth(now).books) {
-      if (b.place != "holder") continue;
-      model.move_book(b.id, Eigen::Isometry3d(Eigen::Translation3d(-2.0, 1.0 + 0.3 * b.id, scene.floor_z + 0.2)));
-      taken += " " + std::to_string(b.id);
-    }
-    BookRecord& rec = book(status.current_book);
-    rec.handed_over = true;
-    user_event_t u;
-    u.utime = now;
-    u.event = "done";
-    u.detail = "the librarian took book(s)" + taken + " off the holder (eval harness)";
-    comp.bus().publish(ch_user, &u);
-    trace("LIBRARIAN took truth book(s)" + taken + " off the holder and sent \"done\"");
   }
 
   int64_t last_periodic = 0;

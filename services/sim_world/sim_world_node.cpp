@@ -14,6 +14,9 @@ SimWorldSettings SimWorldSettings::from_config(const Config& root) {
   s.gripper_setpoint_channel = root.get<std::string>("channels.gripper_setpoint");
   s.sim_state_channel = root.get<std::string>("channels.sim_state");
   s.ground_truth_channel = root.get<std::string>("channels.ground_truth");
+  s.task_status_channel = root.get_channel("channels.task_status");
+  s.user_event_channel = root.get_channel("channels.user_event");
+  s.librarian = SimLibrarianParams::from_config(root);
   const std::string file = root.get<std::string>("scene.file");
   namespace fs = std::filesystem;
   fs::path p(file);
@@ -43,9 +46,35 @@ SimWorldSettings SimWorldSettings::from_config(const Config& root) {
 SimWorldNode::SimWorldNode(const SimWorldSettings& settings)
     : Component("sim_world", "mujoco"),
       settings_(settings),
-      world_(scene::load_scene(settings.scene_file, settings.seed), settings.timing) {
+      world_(scene::load_scene(settings.scene_file, settings.seed), settings.timing),
+      librarian_(settings.librarian) {
   subscribe(settings_.arm_setpoint_channel, &SimWorldNode::on_arm_setpoint);
   subscribe(settings_.gripper_setpoint_channel, &SimWorldNode::on_gripper_setpoint);
+  subscribe(settings_.task_status_channel, &SimWorldNode::on_task_status);
+}
+
+void SimWorldNode::on_task_status(const task_status_t& msg) {
+  // The librarian's clock is the simulation's (a status stamped by another clock would not start the wait).
+  librarian_.on_task_state(msg.state, world_.now_utime());
+}
+
+void SimWorldNode::librarian_act() {
+  auto& model = world_.model();
+  const int64_t now = world_.now_utime();
+  std::string taken;
+  int n = 0;
+  for (const auto& b : model.ground_truth(now).books) {
+    if (b.place != "holder") continue;
+    // Out of the scene: on the floor 2 m behind the robot, a book's length apart.
+    model.move_book(b.id, Eigen::Isometry3d(Eigen::Translation3d(-2.0, 1.0 + 0.4 * n++, model.scene().floor_z + 0.2)));
+    taken += " " + std::to_string(b.id);
+  }
+  user_event_t u;
+  u.utime = now;
+  u.event = "done";
+  u.detail = taken.empty() ? "the simulated librarian found no book on the holder"
+                           : "the simulated librarian took book" + taken + " off the holder";
+  publish(settings_.user_event_channel, u);
 }
 
 void SimWorldNode::on_arm_setpoint(const arm_setpoint_t& msg) {
@@ -69,7 +98,10 @@ void SimWorldNode::publish_outputs(const SimWorldOutputs& out) {
   for (const auto& g : out.ground_truths) publish(settings_.ground_truth_channel, g);
 }
 
-void SimWorldNode::advance_to(int64_t utime) { publish_outputs(world_.advance_to(utime)); }
+void SimWorldNode::advance_to(int64_t utime) {
+  publish_outputs(world_.advance_to(utime));
+  if (librarian_.due(world_.now_utime())) librarian_act();
+}
 
 void SimWorldNode::on_tick(int64_t now_utime) {
   if (settings_.drive != "wall") return;

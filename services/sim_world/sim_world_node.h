@@ -1,14 +1,18 @@
 #pragma once
 /// @file
 /// sim_world as a Component: ARM_SETPOINT, GRIPPER_SETPOINT in; SIM_STATE,
-/// SIM_GROUND_TRUTH out, stamped with simulation time.
+/// SIM_GROUND_TRUTH out, stamped with simulation time. The simulated librarian (sim_librarian.h) reads
+/// TASK_STATUS and, having taken a book off the holder, publishes USER_EVENT "done".
 
 #include <cstdint>
 #include <memory>
 #include <string>
 
+#include "bookgrasp/task_status_t.hpp"
+#include "bookgrasp/user_event_t.hpp"
 #include "common/component.h"
 #include "common/config.h"
+#include "services/sim_world/sim_librarian.h"
 #include "services/sim_world/sim_world.h"
 
 namespace bookgrasp {
@@ -19,6 +23,9 @@ struct SimWorldSettings {
   std::string gripper_setpoint_channel;
   std::string sim_state_channel;
   std::string ground_truth_channel;
+  std::string task_status_channel;  ///< in: the librarian follows the task
+  std::string user_event_channel;   ///< out: the librarian's "done"
+  SimLibrarianParams librarian;
   std::string scene_file;       ///< resolved path of the scene YAML
   uint64_t seed = 0;
   SimWorldTiming timing;
@@ -50,10 +57,14 @@ class SimWorldNode : public Component {
  private:
   void on_arm_setpoint(const arm_setpoint_t& msg);
   void on_gripper_setpoint(const gripper_setpoint_t& msg);
+  void on_task_status(const task_status_t& msg);
+  /// The librarian's turn: every book on the holder goes out of the scene, then USER_EVENT "done".
+  void librarian_act();
   void publish_outputs(const SimWorldOutputs& out);
 
   SimWorldSettings settings_;
   SimWorld world_;
+  SimLibrarian librarian_;
   int64_t wall_start_ = -1;
   int64_t sim_start_ = 0;
 };

@@ -60,3 +60,81 @@ TEST(SimWorldNode, ComposedModePublishesAndRejectsBadSetpoints) {
   EXPECT_EQ(sink.states.back().utime, 1000000000000000 + 50000);
   EXPECT_EQ(n.outputs().at("SIM_GROUND_TRUTH").count, 1);
 }
+
+namespace {
+struct UserSink {
+  std::vector<user_event_t> events;
+  void on(const lcm::ReceiveBuffer*, const std::string&, const user_event_t* m) { events.push_back(*m); }
+};
+
+std::string place_of(SimWorldNode& n, int id) {
+  for (const auto& b : n.world().model().ground_truth(0).books)
+    if (b.id == id) return b.place;
+  return "?";
+}
+}  // namespace
+
+// Not in the paper, simulation only: the coordinator leaves a book too tall for the lower shelf on the holder
+// (WAIT_BOOK_TAKEN); take_after_s later the librarian has taken it out of the scene and says "done", once.
+TEST(SimWorldNode, TheLibrarianTakesTheBookOffTheHolderAndSaysDone) {
+  Composition comp;
+  SimWorldNode& n = comp.add(std::make_unique<SimWorldNode>(settings()));
+  UserSink users;
+  comp.bus().subscribe("USER_EVENT", &UserSink::on, &users);
+  const int64_t t0 = n.world().now_utime();
+  // A book lying on its cover on the holder's base plate (top 2 cm above the holder frame's origin).
+  const auto& book = n.world().model().scene().books.front();
+  const int id = book.id;
+  const auto& holder = n.world().model().scene().holder_pose;
+  n.world().model().move_book(id, holder * Eigen::Translation3d(0.0, 0.0, 0.02 + book.width_m / 2 + 0.003) *
+                                      Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitX()));
+  ASSERT_EQ(place_of(n, id), "holder");
+
+  task_status_t st;
+  st.utime = t0;
+  st.state = "WAIT_USER";
+  comp.bus().publish("TASK_STATUS", &st);
+  comp.spin();
+  n.advance_to(t0 + 3000000);
+  comp.spin();
+  EXPECT_TRUE(users.events.empty()) << "WAIT_USER is the user's, not the librarian's";
+  EXPECT_EQ(place_of(n, id), "holder");
+
+  st.state = "WAIT_BOOK_TAKEN";
+  comp.bus().publish("TASK_STATUS", &st);
+  comp.spin();
+  n.advance_to(n.world().now_utime() + 1500000);  // take_after_s 2.0: not yet
+  comp.spin();
+  EXPECT_TRUE(users.events.empty());
+  n.advance_to(n.world().now_utime() + 600000);
+  comp.spin();
+  ASSERT_EQ(users.events.size(), 1u);
+  EXPECT_EQ(users.events[0].event, "done");
+  EXPECT_NE(users.events[0].detail.find("took book " + std::to_string(id)), std::string::npos)
+      << users.events[0].detail;
+  EXPECT_EQ(place_of(n, id), "other");
+  comp.bus().publish("TASK_STATUS", &st);  // still waiting (the coordinator has not seen "done" yet): once per visit
+  comp.spin();
+  n.advance_to(n.world().now_utime() + 3000000);
+  comp.spin();
+  EXPECT_EQ(users.events.size(), 1u);
+}
+
+TEST(SimLibrarian, ActsOncePerVisitAfterItsDelayAndNotWhenDisabled) {
+  SimLibrarianParams p;
+  p.take_after_s = 2.0;
+  SimLibrarian l(p);
+  EXPECT_FALSE(l.due(0));
+  l.on_task_state("WAIT_BOOK_TAKEN", 1000000);
+  EXPECT_FALSE(l.due(2900000));
+  EXPECT_TRUE(l.due(3000000));
+  EXPECT_FALSE(l.due(4000000));
+  l.on_task_state("PARK", 5000000);
+  l.on_task_state("WAIT_BOOK_TAKEN", 9000000);  // the next tall book
+  EXPECT_FALSE(l.due(10000000));
+  EXPECT_TRUE(l.due(11000000));
+  p.enabled = false;
+  SimLibrarian off(p);
+  off.on_task_state("WAIT_BOOK_TAKEN", 0);
+  EXPECT_FALSE(off.due(100000000));
+}
