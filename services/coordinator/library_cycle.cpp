@@ -754,7 +754,7 @@ void LibraryCycle::enter(CycleState s) {
       message_ = "book " + std::to_string(progress_.books_moved) + " is " + mm(held_box_height()) +
                  " tall: the lower shelf takes books up to " + mm(lower_shelf_max_book_height(g)) +
                  " (lower_shelf.gap_to_upper_shelf_m - 2 x book_clearance_m); it stays on the holder: take it off "
-                 "and send \"done\"";
+                 "and send \"taken\"";
       break;
     case CycleState::kMoveToHolderPreGrasp:
       // Every way to the grasp from the holder (the user's "done", a resumed task) passes here.
@@ -1090,7 +1090,8 @@ std::vector<CycleRequest> LibraryCycle::on_user(const UserEvent& e) {
   } else if (e.event == "done" && state_ == CycleState::kWaitUser) {
     message_ = "user \"done\"" + (e.detail.empty() ? std::string("") : ": " + e.detail);
     succeed(CycleState::kMoveToHolderPreGrasp);
-  } else if (e.event == "done" && state_ == CycleState::kWaitBookTaken) {
+  } else if (e.event == "taken" && state_ == CycleState::kWaitBookTaken) {
+    // Not "done": the coordinator's own demo "done" for WAIT_USER comes back on the bus once it is in this state.
     book_done(true);
     succeed(CycleState::kPark);
   }

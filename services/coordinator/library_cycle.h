@@ -207,7 +207,7 @@ enum class CycleState {
   kParkForUser,
   kWaitUser,
   /// Not in the paper: the book is taller than the lower shelf takes (lower_shelf_max_book_height): it stays on
-  /// the holder until the librarian takes it off and sends "done"; then the next book.
+  /// the holder until the librarian takes it off and sends USER_EVENT "taken"; then the next book.
   kWaitBookTaken,
   kMoveToHolderPreGrasp,
   kOpenForHolderGrasp,

@@ -382,7 +382,7 @@ struct FullCycleHarness::Impl {
     const std::string prev = status.state;
     const int prev_moved = status.books_moved;
     status = *m;
-    // sim_world's librarian took a book too tall for the lower shelf off the holder: its "done" ended the cycle.
+    // sim_world's librarian took a book too tall for the lower shelf off the holder: its "taken" ended the cycle.
     if (prev == "WAIT_BOOK_TAKEN" && m->books_moved > prev_moved) book(prev_moved).handed_over = true;
     if (m->books_moved > prev_moved) {
       for (int i = prev_moved; i < m->books_moved; ++i) {

@@ -79,7 +79,7 @@ struct BookRecord {
   int grasp_successes = 0;           ///< ... after which the book was in the gripper (physics)
   bool moved = false;                ///< completed the whole cycle (on the lower shelf)
   /// Too tall for the lower shelf: the coordinator left it on the holder (WAIT_BOOK_TAKEN) and sim_world's
-  /// librarian took it out of the scene and said "done".
+  /// librarian took it out of the scene and said "taken".
   bool handed_over = false;
   /// SIM_GROUND_TRUTH place of the book when the coordinator left RELEASE_ON_HOLDER ("" = it never did):
   /// "holder" = the book was put on the holder; anything else = lost on the way or while placing.

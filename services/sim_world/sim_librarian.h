@@ -3,7 +3,7 @@
 /// The simulated librarian (not in the paper; simulation only): a book the coordinator leaves on the holder
 /// because it is too tall for the lower shelf (TASK_STATUS state WAIT_BOOK_TAKEN) is taken off it by a person.
 /// This core decides when, in simulation time; sim_world's node moves the book out of the scene and publishes
-/// the person's USER_EVENT "done". No LCM, no MuJoCo.
+/// the person's USER_EVENT "taken". No LCM, no MuJoCo.
 
 #include <cstdint>
 #include <string>
@@ -15,7 +15,7 @@ namespace bookgrasp {
 /// librarian.* of config/services/sim_world.yaml.
 struct SimLibrarianParams {
   bool enabled = true;        ///< false: nobody comes (the task waits in WAIT_BOOK_TAKEN)
-  double take_after_s = 2.0;  ///< simulation seconds from WAIT_BOOK_TAKEN to the book taken and "done"
+  double take_after_s = 2.0;  ///< simulation seconds from WAIT_BOOK_TAKEN to the book taken and "taken" sent
   /// Reads librarian.enabled and librarian.take_after_s of `root`. Throws ConfigError naming a bad key.
   static SimLibrarianParams from_config(const Config& root);
 };

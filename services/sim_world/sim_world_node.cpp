@@ -71,7 +71,7 @@ void SimWorldNode::librarian_act() {
   }
   user_event_t u;
   u.utime = now;
-  u.event = "done";
+  u.event = "taken";
   u.detail = taken.empty() ? "the simulated librarian found no book on the holder"
                            : "the simulated librarian took book" + taken + " off the holder";
   publish(settings_.user_event_channel, u);

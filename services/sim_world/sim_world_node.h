@@ -2,7 +2,7 @@
 /// @file
 /// sim_world as a Component: ARM_SETPOINT, GRIPPER_SETPOINT in; SIM_STATE,
 /// SIM_GROUND_TRUTH out, stamped with simulation time. The simulated librarian (sim_librarian.h) reads
-/// TASK_STATUS and, having taken a book off the holder, publishes USER_EVENT "done".
+/// TASK_STATUS and, having taken a book off the holder, publishes USER_EVENT "taken".
 
 #include <cstdint>
 #include <memory>
@@ -24,7 +24,7 @@ struct SimWorldSettings {
   std::string sim_state_channel;
   std::string ground_truth_channel;
   std::string task_status_channel;  ///< in: the librarian follows the task
-  std::string user_event_channel;   ///< out: the librarian's "done"
+  std::string user_event_channel;   ///< out: the librarian's "taken"
   SimLibrarianParams librarian;
   std::string scene_file;       ///< resolved path of the scene YAML
   uint64_t seed = 0;
@@ -58,7 +58,7 @@ class SimWorldNode : public Component {
   void on_arm_setpoint(const arm_setpoint_t& msg);
   void on_gripper_setpoint(const gripper_setpoint_t& msg);
   void on_task_status(const task_status_t& msg);
-  /// The librarian's turn: every book on the holder goes out of the scene, then USER_EVENT "done".
+  /// The librarian's turn: every book on the holder goes out of the scene, then USER_EVENT "taken".
   void librarian_act();
   void publish_outputs(const SimWorldOutputs& out);
 

@@ -56,7 +56,7 @@ std::vector<std::string> TaskRunLog::on_status(const task_status_t& s) {
     MovedBook b;
     b.index = books_moved_;
     b.cycle_s = static_cast<double>(last_utime_ - book_start_utime_) * 1e-6;
-    b.handed_over = state_ == "WAIT_BOOK_TAKEN";  // the count went up when the librarian said "done"
+    b.handed_over = state_ == "WAIT_BOOK_TAKEN";  // the count went up when the librarian said "taken"
     moved_.push_back(b);
     ++books_moved_;
     book_start_utime_ = last_utime_;

@@ -79,7 +79,7 @@ class FakeLibrary {
   int missed_holder_grasps = 0;              ///< ... on the holder (the book stays there)
   bool servo_silent = false;                 ///< servo never answers (timeouts)
   bool user_answers = true;                  ///< sends "done" in WAIT_USER after 1 s
-  bool librarian_answers = true;             ///< in WAIT_BOOK_TAKEN: takes the book off the holder, "done" after 1 s
+  bool librarian_answers = true;             ///< in WAIT_BOOK_TAKEN: takes the book off the holder, "taken" after 1 s
   int arm_moves_during_planning = 0;         ///< the next N plans: the joints move 0.05 rad before the answer
   int coast_after_servo_ticks = 0;           ///< after each servo answer the arm still EXECUTES this many ticks
   /// State name -> base z the TCP cannot go below in that state's straight moves (the held book stands on its
@@ -154,7 +154,7 @@ class FakeLibrary {
         }
         bookgrasp::UserEvent u;
         u.utime = t;
-        u.event = "done";
+        u.event = librarian ? "taken" : "done";
         handle(cycle, cycle.on_user(u));
         wait_user_since_ = -1;
       }

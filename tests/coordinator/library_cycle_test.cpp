@@ -211,7 +211,7 @@ TEST(LibraryCycle, ThreeBooksWholeCycleEveryTransitionAndPlacements) {
 }
 
 // Not in the paper: a book taller than the lower shelf takes (coordinator.yaml: 0.30 - 2 x 0.013 = 0.274 m) is not
-// taken off the holder; the librarian takes it, says "done", and the cycle goes on with the next book.
+// taken off the holder; the librarian takes it, says "taken", and the cycle goes on with the next book.
 TEST(LibraryCycle, ABookTooTallForTheLowerShelfStaysOnTheHolderForTheLibrarian) {
   const CycleSettings cs = settings();
   ASSERT_NEAR(bookgrasp::lower_shelf_max_book_height(cs.geometry), 0.274, 1e-9);
@@ -231,7 +231,7 @@ TEST(LibraryCycle, ABookTooTallForTheLowerShelfStaysOnTheHolderForTheLibrarian) 
   EXPECT_EQ(count(w.states, "WAIT_BOOK_TAKEN"), 1);
   EXPECT_EQ(w.holder_grasps.size(), 2u) << "the tall book is never taken off the holder by the robot";
   EXPECT_NE(waiting_message.find("290.0 mm tall"), std::string::npos) << waiting_message;
-  EXPECT_NE(waiting_message.find("take it off"), std::string::npos) << waiting_message;
+  EXPECT_NE(waiting_message.find("take it off and send \"taken\""), std::string::npos) << waiting_message;
   // The progress: three books done, the first handed over; the lower shelf's first slot went to book 1.
   ASSERT_EQ(cycle.progress().moved.size(), 3u);
   EXPECT_TRUE(cycle.progress().moved[0].handed_over);
@@ -247,6 +247,12 @@ TEST(LibraryCycle, WithoutTheLibrarianTheTallBookWaitsOnTheHolder) {
   LibraryCycle cycle(settings(), std::nullopt);
   w.run(
       cycle, [&] { return done_or_aborted(cycle); }, 60000);  // 10 min of message time
+  EXPECT_EQ(cycle.state(), CycleState::kWaitBookTaken) << cycle.status().message;
+  // A "done" (the coordinator's own demo "done" for WAIT_USER, back from the bus) does not end the wait.
+  bookgrasp::UserEvent echo;
+  echo.utime = w.t;
+  echo.event = "done";
+  cycle.on_user(echo);
   EXPECT_EQ(cycle.state(), CycleState::kWaitBookTaken) << cycle.status().message;
   EXPECT_TRUE(w.on_holder.has_value());
   EXPECT_EQ(cycle.progress().place, BookPlace::kOnHolder);

@@ -75,8 +75,8 @@ std::string place_of(SimWorldNode& n, int id) {
 }  // namespace
 
 // Not in the paper, simulation only: the coordinator leaves a book too tall for the lower shelf on the holder
-// (WAIT_BOOK_TAKEN); take_after_s later the librarian has taken it out of the scene and says "done", once.
-TEST(SimWorldNode, TheLibrarianTakesTheBookOffTheHolderAndSaysDone) {
+// (WAIT_BOOK_TAKEN); take_after_s later the librarian has taken it out of the scene and says "taken", once.
+TEST(SimWorldNode, TheLibrarianTakesTheBookOffTheHolderAndSaysTaken) {
   Composition comp;
   SimWorldNode& n = comp.add(std::make_unique<SimWorldNode>(settings()));
   UserSink users;
@@ -109,11 +109,11 @@ TEST(SimWorldNode, TheLibrarianTakesTheBookOffTheHolderAndSaysDone) {
   n.advance_to(n.world().now_utime() + 600000);
   comp.spin();
   ASSERT_EQ(users.events.size(), 1u);
-  EXPECT_EQ(users.events[0].event, "done");
+  EXPECT_EQ(users.events[0].event, "taken");
   EXPECT_NE(users.events[0].detail.find("took book " + std::to_string(id)), std::string::npos)
       << users.events[0].detail;
   EXPECT_EQ(place_of(n, id), "other");
-  comp.bus().publish("TASK_STATUS", &st);  // still waiting (the coordinator has not seen "done" yet): once per visit
+  comp.bus().publish("TASK_STATUS", &st);  // still waiting (the coordinator has not seen "taken" yet): once per visit
   comp.spin();
   n.advance_to(n.world().now_utime() + 3000000);
   comp.spin();
