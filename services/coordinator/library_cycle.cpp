@@ -280,7 +280,9 @@ void LibraryCycle::check_timeout() {
     return;
   }
   if (state_ == CycleState::kWaitUser || state_ == CycleState::kWaitBookTaken) {
-    abort("timeout in " + what + ": no \"done\" from the user within " + std::to_string(s_.user_timeout_s) + " s");
+    const bool user = state_ == CycleState::kWaitUser;
+    abort("timeout in " + what + ": no " + (user ? "\"done\" from the user" : "\"taken\" from the librarian") +
+          " within " + std::to_string(s_.user_timeout_s) + " s");
     return;
   }
   if (motion_.kind == MotionKind::kPlanned && motion_.planning) {
@@ -867,6 +869,7 @@ CycleState LibraryCycle::resume_target() const {
       return CycleState::kMoveToHolder;
     case BookPlace::kOnHolder:
       if (in(was, {CycleState::kRetreatFromHolder})) return CycleState::kRetreatFromHolder;
+      if (in(was, {CycleState::kWaitBookTaken})) return CycleState::kWaitBookTaken;  // the arm is parked
       if (in(was, {CycleState::kApproachHolder, CycleState::kGraspFromHolder, CycleState::kBackOutFromHolder}))
         return CycleState::kBackOutFromHolder;
       return CycleState::kParkForUser;

@@ -259,6 +259,27 @@ TEST(LibraryCycle, WithoutTheLibrarianTheTallBookWaitsOnTheHolder) {
   EXPECT_TRUE(w.lower.empty());
 }
 
+TEST(LibraryCycle, ACoordinatorRestartedWhileTheTallBookWaitsForTheLibrarianWaitsAgain) {
+  FakeLibrary w({{0, 0.025, 0.29, 0.300}, {1, 0.020, 0.18, 0.273}});
+  w.librarian_answers = false;
+  auto first = std::make_unique<LibraryCycle>(settings(), std::nullopt);
+  w.run(*first, [&] { return first->state() == CycleState::kWaitBookTaken || done_or_aborted(*first); });
+  ASSERT_EQ(first->state(), CycleState::kWaitBookTaken) << first->status().message;
+  const auto progress = first->progress();
+  first.reset();
+  LibraryCycle second(settings(), progress);
+  w.run(second, [&] { return second.state() == CycleState::kWaitBookTaken || done_or_aborted(second); });
+  ASSERT_EQ(second.state(), CycleState::kWaitBookTaken) << second.status().message;
+  EXPECT_EQ(count(w.states, "WAIT_USER"), 1) << "the user is not asked again";
+  w.librarian_answers = true;
+  w.run(second, [&] { return done_or_aborted(second); });
+  ASSERT_EQ(second.state(), CycleState::kDone) << second.status().message;
+  ASSERT_EQ(w.lower.size(), 1u);
+  EXPECT_EQ(w.lower[0].first.id, 1);
+  ASSERT_EQ(w.taken_by_librarian.size(), 1u);
+  EXPECT_EQ(w.taken_by_librarian[0].id, 0);
+}
+
 TEST(LibraryCycle, RetriesNextRegionNoGraspMissedGraspAndPlanFailure) {
   FakeLibrary w(three_books());
   w.next_region_once = 1;  // BwH rank 0 picks a false region once
