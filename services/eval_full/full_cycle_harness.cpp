@@ -233,7 +233,6 @@ struct FullCycleHarness::Impl {
     t = t0;
     sim->advance_to(t);
     comp.spin();
-    if (o.verbose) touch_diag();
     truth = sim->world().model().ground_truth(t);
     for (const auto& b : truth.books)
       if (b.place == "upper_shelf") ++res.books_on_upper_shelf;
@@ -641,10 +640,10 @@ struct FullCycleHarness::Impl {
       if (model.geom_owner_id(book) < 0) std::swap(robot, book);
       const int b = model.geom_owner_id(book), r = model.geom_owner_id(robot);
       if (b < 0 || (r != scene::kOwnerRobotArm && r != scene::kOwnerGripperFinger)) continue;
-      const bool holding = status.state != "SERVO_BOOK" && status.state != "MOVE_TO_BWH_START" &&
-                           status.state != "SERVO_STRIPE" && status.state != "MOVE_TO_STRIPE_START" &&
-                           status.state != "MOVE_TO_PRE_GRASP";
-      if (holding && b == target_book_id) continue;
+      const bool before_grasp = status.state == "SERVO_BOOK" || status.state == "MOVE_TO_BWH_START" ||
+                                status.state == "SERVO_STRIPE" || status.state == "MOVE_TO_STRIPE_START" ||
+                                status.state == "MOVE_TO_PRE_GRASP";
+      if (!before_grasp && b == target_book_id) continue;  // inserting, holding, placing: its own book
       const char* rn = mj_id2name(mm, mjOBJ_GEOM, robot);
       const std::string key = std::string(rn ? rn : "?") + " book " + std::to_string(b);
       if (!touches_seen.insert(key).second) continue;
@@ -658,6 +657,7 @@ struct FullCycleHarness::Impl {
     t += step_us;
     sim->advance_to(t);
     comp.spin();
+    if (o.verbose) touch_diag();
     if (o.verbose && (status.state == "PLACE_ON_HOLDER" || status.state == "RELEASE_ON_HOLDER") &&
         t - last_holder_diag >= 200000) {
       last_holder_diag = t;

@@ -26,7 +26,8 @@ class SimLibrarian {
   /// The librarian with `params`.
   explicit SimLibrarian(const SimLibrarianParams& params) : p_(params) {}
 
-  /// The task's state as of `utime` (TASK_STATUS.state): a new visit to WAIT_BOOK_TAKEN starts the wait.
+  /// The task's state (TASK_STATUS.state) seen at simulation time `utime`: a new visit to WAIT_BOOK_TAKEN
+  /// starts the wait.
   void on_task_state(const std::string& state, int64_t utime);
   /// True exactly once per visit, at the first `utime` at least take_after_s after it began.
   bool due(int64_t utime);
@@ -35,7 +36,7 @@ class SimLibrarian {
   SimLibrarianParams p_;
   bool waiting_ = false;  ///< the task is in WAIT_BOOK_TAKEN
   bool acted_ = false;    ///< ... and the librarian has acted in this visit
-  int64_t since_ = 0;     ///< when the visit began (TASK_STATUS utime)
+  int64_t since_ = 0;     ///< when the visit began (simulation time)
 };
 
 }  // namespace bookgrasp
