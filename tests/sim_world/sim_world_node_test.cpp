@@ -119,22 +119,3 @@ TEST(SimWorldNode, TheLibrarianTakesTheBookOffTheHolderAndSaysTaken) {
   comp.spin();
   EXPECT_EQ(users.events.size(), 1u);
 }
-
-TEST(SimLibrarian, ActsOncePerVisitAfterItsDelayAndNotWhenDisabled) {
-  SimLibrarianParams p;
-  p.take_after_s = 2.0;
-  SimLibrarian l(p);
-  EXPECT_FALSE(l.due(0));
-  l.on_task_state("WAIT_BOOK_TAKEN", 1000000);
-  EXPECT_FALSE(l.due(2900000));
-  EXPECT_TRUE(l.due(3000000));
-  EXPECT_FALSE(l.due(4000000));
-  l.on_task_state("PARK", 5000000);
-  l.on_task_state("WAIT_BOOK_TAKEN", 9000000);  // the next tall book
-  EXPECT_FALSE(l.due(10000000));
-  EXPECT_TRUE(l.due(11000000));
-  p.enabled = false;
-  SimLibrarian off(p);
-  off.on_task_state("WAIT_BOOK_TAKEN", 0);
-  EXPECT_FALSE(off.due(100000000));
-}
