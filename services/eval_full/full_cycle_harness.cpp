@@ -662,15 +662,15 @@ struct FullCycleHarness::Impl {
     const auto& model = sim->world().model();
     const mjModel* mm = model.model();
     const mjData* dd = model.data();
+    const bool before_grasp = status.state == "SERVO_BOOK" || status.state == "MOVE_TO_BWH_START" ||
+                              status.state == "SERVO_STRIPE" || status.state == "MOVE_TO_STRIPE_START" ||
+                              status.state == "MOVE_TO_PRE_GRASP";
     for (int i = 0; i < dd->ncon; ++i) {
       const mjContact& c = dd->contact[i];
       int robot = c.geom1, book = c.geom2;
       if (model.geom_owner_id(book) < 0) std::swap(robot, book);
       const int b = model.geom_owner_id(book), r = model.geom_owner_id(robot);
       if (b < 0 || (r != scene::kOwnerRobotArm && r != scene::kOwnerGripperFinger)) continue;
-      const bool before_grasp = status.state == "SERVO_BOOK" || status.state == "MOVE_TO_BWH_START" ||
-                                status.state == "SERVO_STRIPE" || status.state == "MOVE_TO_STRIPE_START" ||
-                                status.state == "MOVE_TO_PRE_GRASP";
       if (!before_grasp && b == target_book_id) continue;  // inserting, holding, placing: its own book
       const char* rn = mj_id2name(mm, mjOBJ_GEOM, robot);
       const std::string key = std::string(rn ? rn : "?") + " book " + std::to_string(b);

@@ -266,13 +266,16 @@ PlanOutcome MotionPlanner::plan(const PlanningScene& scene, const PlanRequest& r
                          Bound{req.max_tool_pitch_rad, pitch_of, "pitches the tool's z axis", "horizontal",
                                "max_tool_pitch_rad"}}) {
     if (!(b.limit > 0)) continue;
-    for (const auto& [end_name, r] : {std::pair<const char*, Eigen::Matrix3d>{"start", start_tip.linear()},
-                                      std::pair<const char*, Eigen::Matrix3d>{"goal", goal_r}})
-      if (b.angle(r) > b.limit)
-        return fail(std::string(end_name) == "start" ? PlanFailure::kStartInCollision : PlanFailure::kInvalidRequest,
-                    std::string("the ") + end_name + " " + b.what + " " +
-                                                      fmt(b.angle(r)) + " rad from " + b.from + ", more than " +
-                                                      b.key + " " + fmt(b.limit));
+    struct End {
+      const char* name;
+      Eigen::Matrix3d r;
+      PlanFailure failure;
+    };
+    for (const End& e : {End{"start", start_tip.linear(), PlanFailure::kStartInCollision},
+                         End{"goal", goal_r, PlanFailure::kInvalidRequest}})
+      if (b.angle(e.r) > b.limit)
+        return fail(e.failure, std::string("the ") + e.name + " " + b.what + " " + fmt(b.angle(e.r)) + " rad from " +
+                                   b.from + ", more than " + b.key + " " + fmt(b.limit));
   }
   const CollisionReport start_report = scene.check(start);
   if (start_report.collision)

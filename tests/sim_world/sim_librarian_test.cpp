@@ -4,6 +4,9 @@
 
 #include <gtest/gtest.h>
 
+#include <string>
+#include <utility>
+
 namespace bookgrasp {
 namespace {
 
@@ -24,6 +27,21 @@ TEST(SimLibrarian, ActsOncePerVisitAfterItsDelayAndNotWhenDisabled) {
   SimLibrarian off(p);
   off.on_task_state("WAIT_BOOK_TAKEN", 0);
   EXPECT_FALSE(off.due(100000000));
+}
+
+TEST(SimLibrarian, BadConfigValuesNameTheKey) {
+  for (const auto& [yaml, key] :
+       {std::pair<std::string, std::string>{"librarian: {enabled: true, take_after_s: -1}", "librarian.take_after_s"},
+        {"librarian: {take_after_s: 2}", "librarian.enabled"},
+        {"librarian: {enabled: maybe, take_after_s: 2}", "librarian.enabled"}}) {
+    try {
+      SimLibrarianParams::from_config(Config::from_string(yaml));
+      ADD_FAILURE() << yaml << " was accepted";
+    } catch (const ConfigError& e) {
+      EXPECT_NE(std::string(e.what()).find(key), std::string::npos) << e.what();
+    }
+  }
+  EXPECT_NO_THROW(SimLibrarianParams::from_config(Config::from_string("librarian: {enabled: false, take_after_s: 0}")));
 }
 
 }  // namespace
