@@ -42,6 +42,7 @@ DecisionEvent decision_from_message(const grasp_point_t& msg) {
   }
   d.valid = msg.valid;
   d.p1_present = finite3(msg.p1_grasp);
+  if (d.p1_present) d.p1_grasp = Eigen::Vector3d(msg.p1_grasp[0], msg.p1_grasp[1], msg.p1_grasp[2]);
   d.ps_present = finite3(msg.ps_grasp);
   if (d.ps_present) d.ps_grasp = Eigen::Vector3d(msg.ps_grasp[0], msg.ps_grasp[1], msg.ps_grasp[2]);
   if (finite3(msg.gp_grasp)) d.gp_grasp = Eigen::Vector3d(msg.gp_grasp[0], msg.gp_grasp[1], msg.gp_grasp[2]);

@@ -31,6 +31,10 @@ CycleGeometry CycleGeometry::from_config(const Config& c) {
                       c.path_of("cart.shelf_left_y_m"));
   g.stripe_start = vec3(c, "servo.stripe_start_grasp_m");
   g.stripe_fixed_depth = c.get_double("servo.stripe_fixed_depth_m", 0.02, 1.0);
+  g.stripe_left_limit_y = c.get_double("servo.stripe_left_limit_y_m", g.shelf_left_y, g.shelf_right_y);
+  if (g.stripe_left_limit_y >= g.stripe_start.y())
+    throw ConfigError(c.source() + ": " + c.path_of("servo.stripe_left_limit_y_m") +
+                      " must be left of (less than) the Y of " + c.path_of("servo.stripe_start_grasp_m"));
   g.bwh_start_z = c.get_double("servo.bwh_start_z_m", -1.0, 0.0);
   g.bwh_start_offset_x = c.get_double("servo.bwh_start_offset_x_m", -0.3, 0.3);
   g.book_front_z = c.get_double("servo.book_front_z_m", -0.2, 0.3);

@@ -28,6 +28,9 @@ struct CycleGeometry {
   // BSwH and BwH servo starts
   Eigen::Vector3d stripe_start = Eigen::Vector3d::Zero();  ///< position A (grasp frame)
   double stripe_fixed_depth = 0.2;  ///< distance kept to the rear board during the stripe servo
+  /// The stripe servo is stopped when the TCP passes this grasp Y leftwards: further left the gripper comes nearer
+  /// the book holder beside the cart than the planner's margin. The stripe is then free of books right of it.
+  double stripe_left_limit_y = -0.40;
   double bwh_start_z = -0.15;       ///< fixed Z in front of the cart where BwH starts
   double bwh_start_offset_x = 0.0;  ///< added to the start point's X
   double book_front_z = 0.01;       ///< grasp Z of the books' fronts when the arbiter's P1 check gave no depth

@@ -943,11 +943,33 @@ std::vector<CycleRequest> LibraryCycle::on_arm(const ArmEvent& e) {
       message_ = "user \"done\" (automatic)";
       succeed(CycleState::kMoveToHolderPreGrasp);
     }
-  } else {
+  } else if (!(state_ == CycleState::kServoStripe && stripe_left_limit_passed())) {
     drive_motion(e);
   }
   check_timeout();
   return out_;
+}
+
+bool LibraryCycle::stripe_left_limit_passed() {
+  const CycleGeometry& g = s_.geometry;
+  const double y = (cart_frame().inverse() * arm_->end_effector.translation()).y();
+  if (y >= g.stripe_left_limit_y) return false;
+  // The servo moves left only along a visible stripe (or towards an end it tracks there): no book stands right of
+  // here. Further left the gripper would meet the holder beside the cart.
+  out_.push_back(make_request(CycleRequest::Kind::kServoCancel));
+  out_.push_back(make_request(CycleRequest::Kind::kArmStop));
+  const std::string where = "the stripe servo reached its left limit (geometry.servo.stripe_left_limit_y_m " +
+                            mm(g.stripe_left_limit_y) + ", " + mm(g.stripe_left_limit_y - g.shelf_left_y) +
+                            " from the shelf's left end; further left the gripper meets the book holder)";
+  if (p1_check_y_) {
+    fail(where + " without a stripe end, but BwS saw a book at Y " + mm(*p1_check_y_) +
+         ": its stripe end is out of the servo's reach");
+    return true;
+  }
+  message_ = where + ": no book right of it, and BwS sees none: the upper shelf is empty within the arm's reach";
+  progress_.finished = true;
+  succeed(CycleState::kPark);
+  return true;
 }
 
 std::vector<CycleRequest> LibraryCycle::on_markers(const MarkersEvent& e) {
@@ -960,6 +982,8 @@ std::vector<CycleRequest> LibraryCycle::on_markers(const MarkersEvent& e) {
 }
 
 void LibraryCycle::handle_p1_check(const DecisionEvent& d) {
+  p1_check_y_.reset();
+  if (d.p1_present && std::isfinite(d.p1_grasp.y())) p1_check_y_ = d.p1_grasp.y();
   if (d.outcome == "NEED_PS" || (!d.p1_present && !stripe_done_this_attempt_)) {
     message_ = d.outcome == "NEED_PS" ? "no PS yet: BSwH to the stripe end"
                                       : "BwS found no book: BSwH checks whether the stripe is free";

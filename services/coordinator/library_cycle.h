@@ -28,6 +28,7 @@
 /// progress persisted with where the book is.
 
 #include <cstdint>
+#include <limits>
 #include <optional>
 #include <string>
 #include <vector>
@@ -115,6 +116,7 @@ struct DecisionEvent {
   int next_rank = 0;    ///< NEXT_REGION
   bool valid = false;
   bool p1_present = false;  ///< p1_grasp finite
+  Eigen::Vector3d p1_grasp = Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());  ///< P1 (grasp)
   Eigen::Isometry3d gp_base = Eigen::Isometry3d::Identity();
   Eigen::Vector3d gp_grasp = Eigen::Vector3d::Zero();
   bool ps_present = false;
@@ -303,6 +305,8 @@ class LibraryCycle {
   /// After a move that carries the book: if the plates closed on nothing (no contact, narrower than
   /// min_book_width), aborts naming the state ("book N is not in the gripper after STATE") and returns true.
   bool book_lost_from_plates();
+  /// SERVO_STRIPE: true (and the cycle moved on) once the TCP has passed geometry.stripe_left_limit_y leftwards.
+  bool stripe_left_limit_passed();
   void motion_done();
   /// The current book's cycle is over (on the lower shelf, or `handed_over` to the librarian): records it in the
   /// progress, advances the lower shelf's next slot for a placed book, and decides whether the upper shelf is empty.
@@ -340,6 +344,7 @@ class LibraryCycle {
   int attempt_ = 1;
   int step_retries_ = 0;
   bool stripe_done_this_attempt_ = false;
+  std::optional<double> p1_check_y_;  ///< the grasp Y of P1 at this attempt's P1 check, when BwS found a book
   int64_t stripe_request_ = -1;
   int64_t servo_request_ = -1;
   int rank_ = 0;

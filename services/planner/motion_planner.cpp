@@ -5,6 +5,7 @@
 #include <cmath>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <random>
 #include <sstream>
 #include <stdexcept>
@@ -138,6 +139,29 @@ std::string fmt(double v) {
   std::ostringstream s;
   s << v;
   return s.str();
+}
+
+// A valid state near `start` (which violates only the margins) joined to it by a straight segment that `exact_ok`
+// accepts at a fine spacing: random joint-space directions at radii growing to params.start_escape_max_rad, the
+// nearest found first. Deterministic for a seed. Empty when escaping is off (max 0) or nothing was found.
+std::optional<Eigen::VectorXd> find_start_escape(const Eigen::VectorXd& start, const StateCheck& valid,
+                                                 const StateCheck& exact_ok, const ArmKinematics& kin,
+                                                 const MotionPlannerParams& params, uint64_t seed) {
+  if (!(params.start_escape_max_rad > 0) || params.start_escape_attempts <= 0) return std::nullopt;
+  std::mt19937_64 rng(seed ^ 0x5bd1e9955bd1e995ULL);
+  std::normal_distribution<double> normal(0.0, 1.0);
+  const double spacing = std::min(0.002, 0.25 * params.collision_resolution_rad);
+  const int n = static_cast<int>(start.size());
+  for (int i = 0; i < params.start_escape_attempts; ++i) {
+    Eigen::VectorXd dir(n);
+    for (int k = 0; k < n; ++k) dir[k] = normal(rng);
+    if (!(dir.norm() > 1e-9)) continue;
+    const double radius = params.start_escape_max_rad * (i + 1) / params.start_escape_attempts;
+    const Eigen::VectorXd q =
+        (start + radius * dir.normalized()).cwiseMax(kin.lower_limits()).cwiseMin(kin.upper_limits());
+    if (valid(q) && segment_ok(exact_ok, start, q, spacing)) return q;
+  }
+  return std::nullopt;
 }
 
 }  // namespace
@@ -277,10 +301,30 @@ PlanOutcome MotionPlanner::plan(const PlanningScene& scene, const PlanRequest& r
         return fail(e.failure, std::string("the ") + e.name + " " + b.what + " " + fmt(b.angle(e.r)) + " rad from " +
                                    b.from + ", more than " + b.key + " " + fmt(b.limit));
   }
+  // A start within the margins but touching nothing (a servo or a guarded move ended near the holder or a board):
+  // leave the margin on a short straight segment checked on the exact shapes, then plan from there.
+  Eigen::VectorXd search_start = start;
+  std::string escape_note;
   const CollisionReport start_report = scene.check(start);
-  if (start_report.collision)
-    return fail(PlanFailure::kStartInCollision, "start is in collision: " + start_report.describe() +
-                                                    " (closer than the margin; move out before planning)");
+  if (start_report.collision) {
+    const CollisionReport touching = scene.check(start, false);
+    if (touching.collision)
+      return fail(PlanFailure::kStartInCollision, "start is in collision: " + touching.describe() + " (touching)");
+    const StateCheck exact_ok = [&scene, min_up, max_pitch_sin, &kin](const Eigen::VectorXd& q) {
+      const Eigen::Matrix3d r = kin.tip_pose(q).linear();
+      return r(2, 0) >= min_up && std::abs(r(2, 2)) <= max_pitch_sin && !scene.check(q, false).collision;
+    };
+    const std::optional<Eigen::VectorXd> escape = find_start_escape(start, valid, exact_ok, kin, params_, req.seed);
+    if (!escape)
+      return fail(PlanFailure::kStartInCollision, "start is in collision: " + start_report.describe() +
+                                                      " (closer than the margin; no valid state within " +
+                                                      fmt(params_.start_escape_max_rad) +
+                                                      " rad (planner.start_escape_max_rad) reachable in a " +
+                                                      "straight move: move out before planning)");
+    search_start = *escape;
+    escape_note =
+        ", left the margin of " + start_report.describe() + " by " + fmt((*escape - start).norm()) + " rad first";
+  }
 
   // ---- goals ----
   std::vector<Eigen::VectorXd> goals;
@@ -367,7 +411,7 @@ PlanOutcome MotionPlanner::plan(const PlanningScene& scene, const PlanRequest& r
   auto pdef = std::make_shared<ob::ProblemDefinition>(si);
   {
     ob::ScopedState<> s(space);
-    to_state(start, s.get());
+    to_state(search_start, s.get());
     pdef->addStartState(s);
     auto goal_states = std::make_shared<ob::GoalStates>(si);
     for (const auto& g : goals) {
@@ -454,6 +498,11 @@ PlanOutcome MotionPlanner::plan(const PlanningScene& scene, const PlanRequest& r
   };
   const double simplify_begin = elapsed();
   out.path = simplify_path(out.raw_path, motion, params_.simplify_shortcuts, seed);
+  if (!escape_note.empty()) {
+    // The way out of the margin comes first (not simplified away: the start itself is not a valid state).
+    out.raw_path.insert(out.raw_path.begin(), start);
+    out.path.insert(out.path.begin(), start);
+  }
   out.trajectory = parameterize_trapezoidal(out.path, params_.max_velocity, params_.max_acceleration,
                                             params_.sample_period_s);
   out.path_length_rad = path_length(out.path);
@@ -465,6 +514,7 @@ PlanOutcome MotionPlanner::plan(const PlanningScene& scene, const PlanRequest& r
       << fmt(out.path_length_rad) << " rad, " << fmt(out.trajectory.duration_s) << " s";
   if (cell) msg << ", " << cell->tree_size() << " nodes, cell samples " << cell->cell_samples_ok() << "/"
                 << cell->cell_samples_tried();
+  msg << escape_note;
   out.message = msg.str();
   out.planning_time_s = elapsed();
   return out;

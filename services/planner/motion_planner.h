@@ -78,6 +78,10 @@ struct MotionPlannerParams {
   int goal_ik_solutions = 4;               ///< distinct valid IK solutions used as goals for a pose goal
   int goal_ik_attempts = 24;               ///< IK attempts to find them
   double goal_limit_margin_rad = 0.0;      ///< goal IK solutions this close to a joint limit are a last resort
+  /// > 0: a start within the margins but touching nothing is left first on a straight segment (checked on the
+  /// exact shapes) to the nearest valid state found within this joint-space distance. 0: such a start fails.
+  double start_escape_max_rad = 0.0;
+  int start_escape_attempts = 200;         ///< random directions tried, at radii growing to start_escape_max_rad
   Eigen::VectorXd max_velocity;            ///< rad/s per joint (trajectory)
   Eigen::VectorXd max_acceleration;        ///< rad/s^2 per joint (trajectory)
   double sample_period_s = 0.02;           ///< trajectory sample period

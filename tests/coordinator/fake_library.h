@@ -78,6 +78,9 @@ class FakeLibrary {
   std::optional<double> invalid_p1_front_z;
   int missed_holder_grasps = 0;              ///< ... on the holder (the book stays there)
   bool servo_silent = false;                 ///< servo never answers (timeouts)
+  /// > 0: the stripe servo never finds an end and moves the TCP left (grasp -Y) at this speed (m/s) until it is
+  /// cancelled or the arm stopped (a free stripe running out of the image on the left)
+  double stripe_runs_left_m_s = 0.0;
   bool user_answers = true;                  ///< sends "done" in WAIT_USER after 1 s
   bool librarian_answers = true;             ///< in WAIT_BOOK_TAKEN: takes the book off the holder, "taken" after 1 s
   int arm_moves_during_planning = 0;         ///< the next N plans: the joints move 0.05 rad before the answer
@@ -216,6 +219,7 @@ class FakeLibrary {
     d.utime = t;
     d.request_id = request_id;
     d.p1_present = !upper.empty();
+    if (d.p1_present) d.p1_grasp = Eigen::Vector3d(upper.front().height, upper.front().right_y, kP1FrontZ);
     d.ps_present = ps.has_value();
     if (ps) d.ps_grasp = *ps;
     if (!ps) {
@@ -327,6 +331,14 @@ class FakeLibrary {
           break;
         case CycleRequest::Kind::kServo: {
           if (servo_silent) break;
+          if (r.servo_mode == 2 && stripe_runs_left_m_s > 0) {
+            active = r.id;
+            arm_state = 1;
+            executing_plan_ = false;
+            twist_.setZero();
+            twist_.head<3>() = hand_grasp_frame().linear() * Eigen::Vector3d(0, -stripe_runs_left_m_s, 0);
+            break;
+          }
           // With coasting, the servo's answers arrive after an arm state that shows the arm moving.
           auto& answers = coast_after_servo_ticks > 0 ? delayed_ : later;
           if (coast_after_servo_ticks > 0) {

@@ -533,6 +533,44 @@ TEST(LibraryCycle, EmptyByRoomRuleWhenTheLastBookReachesTheLeftEnd) {
   EXPECT_NE(cycle.status().message.find("S_min"), std::string::npos) << cycle.status().message;
 }
 
+// An empty shelf's free stripe runs out of the image on the left and the stripe servo follows it towards the book
+// holder beside the cart (the deployed demo: the palm touched the holder's back, PARK could not plan, abort). The
+// cycle stops the servo where the TCP passes geometry.servo.stripe_left_limit_y_m, and with no book seen by BwS the
+// task is done.
+TEST(LibraryCycle, AFreeStripePastTheLeftLimitEndsTheTaskWhenBwsSeesNoBook) {
+  FakeLibrary w({});
+  w.stripe_runs_left_m_s = 0.1;
+  const CycleSettings s = settings();
+  LibraryCycle cycle(s, std::nullopt);
+  w.run(cycle, [&] { return done_or_aborted(cycle); });
+  ASSERT_EQ(cycle.state(), CycleState::kDone) << cycle.status().message;
+  EXPECT_NE(cycle.status().message.find("stripe_left_limit_y_m"), std::string::npos) << cycle.status().message;
+  EXPECT_NE(cycle.status().message.find("empty within the arm's reach"), std::string::npos) << cycle.status().message;
+  EXPECT_EQ(count(w.states, "SERVO_STRIPE"), 1);
+  EXPECT_EQ(slice(w.states, "SERVO_STRIPE", 3), (std::vector<std::string>{"SERVO_STRIPE", "PARK", "DONE"}));
+  // The TCP went no further left than one 10 ms tick past the limit.
+  const Eigen::Isometry3d to_grasp = hand_grasp_frame().inverse();
+  double leftmost = INFINITY;
+  for (const auto& [state, p] : w.tcp_path) leftmost = std::min(leftmost, (to_grasp * p).y());
+  EXPECT_LT(leftmost, s.geometry.stripe_left_limit_y);
+  EXPECT_GT(leftmost, s.geometry.stripe_left_limit_y - 0.1 * 0.01 - 1e-9);
+  EXPECT_EQ(cycle.progress().books_moved, 0);
+}
+
+// The same servo run while BwS sees a book: the stripe end is beyond the servo's reach, not proof of an empty shelf.
+// A failed attempt (bounded retries), never DONE.
+TEST(LibraryCycle, AFreeStripePastTheLeftLimitWhileBwsSeesABookIsAFailedAttempt) {
+  FakeLibrary w({{0, 0.020, 0.20, -0.30}});
+  w.stripe_runs_left_m_s = 0.1;
+  LibraryCycle cycle(settings(), std::nullopt);
+  w.run(cycle, [&] { return cycle.status().attempt == 2 || done_or_aborted(cycle); });
+  EXPECT_NE(cycle.state(), CycleState::kDone);
+  EXPECT_NE(cycle.status().message.find("BwS saw a book at Y -300.0 mm"), std::string::npos) << cycle.status().message;
+  w.run(cycle, [&] { return done_or_aborted(cycle); });
+  EXPECT_EQ(cycle.state(), CycleState::kAborted) << cycle.status().message;
+  EXPECT_EQ(w.upper.size(), 1u);
+}
+
 /// Runs until `stop`, persists the progress to a file, reloads it into a new cycle (a restarted
 /// coordinator) and finishes; every book must end on the lower shelf exactly once, in order.
 void resume_at(const std::function<bool(const LibraryCycle&, const FakeLibrary&)>& stop, const char* name) {

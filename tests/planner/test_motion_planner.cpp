@@ -303,6 +303,7 @@ TEST_F(MotionPlannerTest, FailureReasons) {
   r = stack_.planner.plan(*scene_, in);
   EXPECT_EQ(r.failure, PlanFailure::kStartInCollision);
   EXPECT_NE(r.message.find("pillar"), std::string::npos) << r.message;
+  EXPECT_NE(r.message.find("touching"), std::string::npos) << r.message;  // not escaped: it is in the pillar
 
   PlanRequest goal_in = req;
   goal_in.goal_joints = q7(0, 1.5707963, 0, 0, 0, 0, 0);
@@ -337,6 +338,45 @@ TEST_F(MotionPlannerTest, FailureReasons) {
   PlanRequest budget = req;
   budget.time_budget_s = -1;
   EXPECT_EQ(stack_.planner.plan(*scene_, budget).failure, PlanFailure::kInvalidRequest);
+}
+
+TEST_F(MotionPlannerTest, AStartWithinTheMarginIsLeftStraightFirst) {
+  // The arm stopped closer to the pillar than the environment margin but touching nothing (a servo that ended near
+  // the holder's back plate): the first state along start_ -> "arm through the pillar" that breaks the margin.
+  const Eigen::VectorXd into = q7(0, 1.5707963, 0, 0, 0, 0, 0);
+  Eigen::VectorXd near = start_;
+  for (double t = 0; t <= 1.0; t += 0.0005) {
+    near = start_ + t * (into - start_);
+    if (scene_->check(near).collision) break;
+  }
+  ASSERT_TRUE(scene_->check(near).collision);
+  ASSERT_FALSE(scene_->check(near, false).collision) << "the margin state must not touch the pillar";
+  ASSERT_GT(settings_.planner.start_escape_max_rad, 0.0) << "config/services/planner.yaml enables the escape";
+  PlanRequest req;
+  req.start = near;
+  req.goal_joints = goal_;
+  req.time_budget_s = 2.0;
+  req.seed = 3;
+  const PlanOutcome r = stack_.planner.plan(*scene_, req);
+  expect_collision_free(*scene_, r);
+  EXPECT_TRUE(r.path.front().isApprox(near));
+  EXPECT_TRUE(r.path.back().isApprox(goal_));
+  EXPECT_NE(r.message.find("left the margin of"), std::string::npos) << r.message;
+  // The way out is short and touches nothing; every later state keeps the margins.
+  ASSERT_GE(r.path.size(), 3u);
+  EXPECT_LE((r.path[1] - near).norm(), settings_.planner.start_escape_max_rad + 1e-9);
+  EXPECT_TRUE(scene_->is_valid(r.path[1]));
+  for (size_t i = 2; i < r.path.size(); ++i)
+    EXPECT_TRUE(segment_collision_free(*scene_, r.path[i - 1], r.path[i], 0.005, true)) << "segment " << i;
+
+  // Without the escape the same start is a start-state failure that says what to do.
+  MotionPlannerParams off = settings_.planner;
+  off.start_escape_max_rad = 0.0;
+  const MotionPlanner strict(stack_.ik, off);
+  const PlanOutcome refused = strict.plan(*scene_, req);
+  EXPECT_EQ(refused.failure, PlanFailure::kStartInCollision);
+  EXPECT_NE(refused.message.find("closer than the margin"), std::string::npos) << refused.message;
+  EXPECT_NE(refused.message.find("start_escape_max_rad"), std::string::npos) << refused.message;
 }
 
 TEST_F(MotionPlannerTest, SameSeedSamePath) {
