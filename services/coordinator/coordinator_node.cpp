@@ -212,6 +212,9 @@ void CoordinatorNode::send(const std::vector<CycleRequest>& requests, int64_t ut
         m.time_budget_s = settings_.plan_time_budget_s;
         m.holding_book = r.holding_book;
         for (int i = 0; i < 3; ++i) m.held_book_size_m[i] = r.book_size[i];
+        m.num_then_poses = static_cast<int32_t>(r.then_poses.size());
+        for (const Eigen::Isometry3d& p : r.then_poses)
+          m.then_poses.push_back(isometry_to_pose(p, "base", "gripper", utime));
         publish(ch_.plan_request, m);
         break;
       }

@@ -306,11 +306,13 @@ void LibraryCycle::start_planned_joints(const std::vector<double>& goal) {
   issue_plan();
 }
 
-void LibraryCycle::start_planned_pose(const Eigen::Isometry3d& goal, bool holding) {
+void LibraryCycle::start_planned_pose(const Eigen::Isometry3d& goal, bool holding,
+                                      std::vector<Eigen::Isometry3d> then) {
   motion_ = Motion{};
   motion_.kind = MotionKind::kPlanned;
   motion_.goal = goal;
   motion_.holding = holding;
+  motion_.then = std::move(then);
   issue_plan();
 }
 
@@ -333,6 +335,7 @@ void LibraryCycle::issue_plan() {
   r.start_joints = arm_->joints;
   motion_.plan_start = arm_->joints;
   r.holding_book = motion_.holding;
+  r.then_poses = motion_.then;
   if (motion_.holding) r.book_size = Eigen::Vector3d(progress_.book_width, held_box_height(), s_.held_book_depth_m);
   out_.push_back(r);
 }
@@ -712,9 +715,16 @@ void LibraryCycle::enter(CycleState s) {
         handle_grasp_decision(d);
       }
       break;
-    case CycleState::kMoveToPreGrasp:
-      start_planned_pose(pre_grasp_pose(gp_base_, progress_.gp_grasp.z(), g), false);
+    case CycleState::kMoveToPreGrasp: {
+      // INSERT and EXTRACT follow: the planner picks a posture from which the arm can make them.
+      const Eigen::Isometry3d grasp = grasp_pose(gp_base_, g);
+      std::vector<Eigen::Isometry3d> then{grasp};
+      for (const Eigen::Isometry3d& p : extract_moves(grasp, cart_frame(), tcp_height(),
+                                                      moves_front_z(progress_.gp_grasp.z(), g) + g.insertion_depth, g))
+        then.push_back(p);
+      start_planned_pose(pre_grasp_pose(gp_base_, progress_.gp_grasp.z(), g), false, std::move(then));
       break;
+    }
     case CycleState::kOpenForGrasp:
     case CycleState::kOpenForHolderGrasp:
     case CycleState::kReleaseOnHolder:
@@ -733,9 +743,12 @@ void LibraryCycle::enter(CycleState s) {
                                  moves_front_z(progress_.gp_grasp.z(), g) + g.insertion_depth, g));
       break;
     }
-    case CycleState::kMoveToHolder:
-      start_planned_pose(holder_pre_place_pose(holder_frame(), tcp_height(), g), true);
+    case CycleState::kMoveToHolder: {
+      std::vector<Eigen::Isometry3d> then = holder_place_moves(holder_frame(), tcp_height(), g);
+      then.push_back(move_along_own_axes(then.back(), Eigen::Vector3d(0, 0, -g.holder_retreat)));
+      start_planned_pose(holder_pre_place_pose(holder_frame(), tcp_height(), g), true, std::move(then));
       break;
+    }
     case CycleState::kPlaceOnHolder:
       start_linear(holder_place_moves(holder_frame(), tcp_height(), g), g.holder_place_guard);
       break;
@@ -764,11 +777,15 @@ void LibraryCycle::enter(CycleState s) {
         enter(CycleState::kWaitBookTaken);
         return;
       }
-      start_planned_pose(
-          move_along_own_axes(holder_place_pose(holder_frame(), holder_regrasp_height(tcp_height(), g), g),
-                              Eigen::Vector3d(0, 0, -g.holder_retreat)),
-          false);
-      break;
+      {
+        const Eigen::Isometry3d regrasp = holder_place_pose(holder_frame(), holder_regrasp_height(tcp_height(), g), g);
+        std::vector<Eigen::Isometry3d> then{regrasp};
+        for (const Eigen::Isometry3d& p : holder_lift_moves(holder_frame(), holder_regrasp_height(tcp_height(), g), g))
+          then.push_back(p);
+        start_planned_pose(move_along_own_axes(regrasp, Eigen::Vector3d(0, 0, -g.holder_retreat)), false,
+                           std::move(then));
+        break;
+      }
     case CycleState::kLiftFromHolder:
       start_linear(holder_lift_moves(holder_frame(), holder_regrasp_height(tcp_height(), g), g));
       break;
@@ -780,9 +797,11 @@ void LibraryCycle::enter(CycleState s) {
               " (it stays in the gripper)");
         return;
       }
+      const Eigen::Isometry3d place = lower_place_pose(cart_frame(), progress_.lower_next_right_y, progress_.book_width,
+                                                       height_held_from_holder(tcp_height(), g), g);
       start_planned_pose(lower_pre_place_pose(cart_frame(), progress_.lower_next_right_y, progress_.book_width,
                                               height_held_from_holder(tcp_height(), g), held_box_height(), g),
-                         true);
+                         true, {place, move_along_own_axes(place, Eigen::Vector3d(0, 0, -g.lower_retreat))});
       break;
     }
     case CycleState::kPlaceOnLowerShelf:

@@ -175,6 +175,7 @@ struct CycleRequest {
   std::vector<double> goal_joints;
   bool holding_book = false;
   Eigen::Vector3d book_size = Eigen::Vector3d::Zero();  ///< width, height, depth
+  std::vector<Eigen::Isometry3d> then_poses;            ///< kPlan, pose goal: the straight moves after it (base)
   int64_t plan_id = 0;
   Eigen::Matrix<double, 6, 1> twist = Eigen::Matrix<double, 6, 1>::Zero();
   double width = 0;
@@ -274,6 +275,7 @@ class LibraryCycle {
     std::vector<double> goal_joints;
     Eigen::Isometry3d goal = Eigen::Isometry3d::Identity();
     bool holding = false;
+    std::vector<Eigen::Isometry3d> then;  ///< the straight moves the state after this planned one makes
     int64_t plan_id = -1;
     std::vector<double> plan_start;  ///< the joints the pending plan starts from
     int64_t command_id = -1;
@@ -296,7 +298,9 @@ class LibraryCycle {
   void check_timeout();
   void set_deadline(double seconds);
   void start_planned_joints(const std::vector<double>& goal);
-  void start_planned_pose(const Eigen::Isometry3d& goal, bool holding);
+  /// A planned move to `goal`; `then`: the straight moves that follow it (the planner picks a goal posture from
+  /// which they stay within the joint limits).
+  void start_planned_pose(const Eigen::Isometry3d& goal, bool holding, std::vector<Eigen::Isometry3d> then = {});
   /// Straight moves through `waypoints`; `guard` > 0: the arm stalling within it of the last one ends the move.
   void start_linear(std::vector<Eigen::Isometry3d> waypoints, double guard = 0);
   void start_gripper(bool grasp);

@@ -164,6 +164,53 @@ std::optional<Eigen::VectorXd> find_start_escape(const Eigen::VectorXd& start, c
   return std::nullopt;
 }
 
+// Whether the straight moves `then` (tool poses in base, in order, the first from `from`) can be followed from the
+// posture `q` by IK in steps of at most params.then_step_m / then_step_rad, each step seeded by the last (a local,
+// continuous path like the arm driver's), every posture params.then_limit_margin_rad inside the joint limits. `why`
+// says which move and joint fail.
+bool straight_moves_trackable(const InverseKinematics& ik, const Eigen::VectorXd& q, const Eigen::Isometry3d& from,
+                              const std::vector<Eigen::Isometry3d>& then, const MotionPlannerParams& params,
+                              std::string* why) {
+  const ArmKinematics& kin = ik.kinematics();
+  constexpr double kMaxJointStepRad = 0.3;  // a larger jump between steps is another IK branch, not a path
+  Eigen::VectorXd at = q;
+  Eigen::Isometry3d a = from;
+  for (size_t m = 0; m < then.size(); ++m) {
+    const Eigen::Isometry3d& b = then[m];
+    const Eigen::Quaterniond ra(a.linear()), rb(b.linear());
+    const double length = (b.translation() - a.translation()).norm();
+    const int steps = std::max(1, static_cast<int>(std::ceil(std::max(length / params.then_step_m,
+                                                                      ra.angularDistance(rb) / params.then_step_rad))));
+    const std::string move =
+        "straight move " + std::to_string(m + 1) + " of " + std::to_string(then.size()) + " (" + fmt(length) + " m)";
+    for (int k = 1; k <= steps; ++k) {
+      const double t = static_cast<double>(k) / steps;
+      Eigen::Isometry3d target = Eigen::Isometry3d::Identity();
+      target.linear() = ra.slerp(t, rb).toRotationMatrix();
+      target.translation() = a.translation() + t * (b.translation() - a.translation());
+      const IkResult r = ik.solve_once(target, at, ik.params().max_iterations, 0);
+      const std::string where = move + " at " + fmt(100.0 * t) + " %";
+      if (!r.success) {
+        *why = where + ": no IK (" + r.reason + ")";
+        return false;
+      }
+      for (int j = 0; j < r.q.size(); ++j)
+        if (r.q[j] < kin.lower_limits()[j] + params.then_limit_margin_rad ||
+            r.q[j] > kin.upper_limits()[j] - params.then_limit_margin_rad) {
+          *why = where + ": " + kin.joint_names()[j] + " at its limit";
+          return false;
+        }
+      if ((r.q - at).cwiseAbs().maxCoeff() > kMaxJointStepRad) {
+        *why = where + ": the posture jumps (another IK branch)";
+        return false;
+      }
+      at = r.q;
+    }
+    a = b;
+  }
+  return true;
+}
+
 }  // namespace
 
 const char* to_string(PlanFailure f) {
@@ -328,6 +375,7 @@ PlanOutcome MotionPlanner::plan(const PlanningScene& scene, const PlanRequest& r
 
   // ---- goals ----
   std::vector<Eigen::VectorXd> goals;
+  std::string then_note;  // the goals could not all be checked for the straight moves after them
   if (!req.goal_is_pose) {
     const CollisionReport r = scene.check(req.goal_joints);
     if (r.collision) return fail(PlanFailure::kGoalInCollision, "goal is in collision: " + r.describe());
@@ -345,6 +393,8 @@ PlanOutcome MotionPlanner::plan(const PlanningScene& scene, const PlanRequest& r
     std::string ik_reason, collision;
     Eigen::VectorXd closest;  // failed attempt that came closest: later seeds also perturb it
     std::vector<Eigen::VectorXd> near_limit_goals;  // valid, but within goal_limit_margin_rad of a joint limit
+    std::vector<Eigen::VectorXd> untrackable_goals;  // valid, but the then_poses leave the joint limits from them
+    std::string untrackable_reason;
     double closest_error = INFINITY;
     for (int attempt = 0; attempt < params_.goal_ik_attempts &&
                           static_cast<int>(goals.size()) < params_.goal_ik_solutions; ++attempt) {
@@ -378,12 +428,23 @@ PlanOutcome MotionPlanner::plan(const PlanningScene& scene, const PlanRequest& r
       // A goal at a joint's limit leaves the straight moves that follow it no room (the arm driver stops a
       // Cartesian motion at a limit): such goals are used only when there is no other.
       const bool near_limit = !kin.within_limits(r.q, -params_.goal_limit_margin_rad);
-      std::vector<Eigen::VectorXd>& list = near_limit ? near_limit_goals : goals;
+      // The straight moves after the goal (then_poses) are tracked from it: a solution from which they run into a
+      // joint limit is a last resort too, after the near-limit ones.
+      std::string why_not;
+      const bool trackable = req.then_poses.empty() ||
+                             straight_moves_trackable(ik_, r.q, req.goal_pose, req.then_poses, params_, &why_not);
+      if (!trackable && untrackable_reason.empty()) untrackable_reason = why_not;
+      std::vector<Eigen::VectorXd>& list = !trackable ? untrackable_goals : near_limit ? near_limit_goals : goals;
       bool distinct = true;
       for (const auto& g : list) distinct = distinct && (g - r.q).norm() > 0.1;
       if (distinct) list.push_back(r.q);
     }
     if (goals.empty()) goals = near_limit_goals;
+    if (goals.empty() && !untrackable_goals.empty()) {
+      goals = untrackable_goals;
+      then_note = "; no goal solution found from which the " + std::to_string(req.then_poses.size()) +
+                  " straight moves after it stay within the joint limits (" + untrackable_reason + ")";
+    }
     if (ik_ok == 0)
       return fail(PlanFailure::kNoIk, "no IK solution for the goal pose after " +
                                           std::to_string(params_.goal_ik_attempts) + " attempts (" + ik_reason + ")");
@@ -514,7 +575,7 @@ PlanOutcome MotionPlanner::plan(const PlanningScene& scene, const PlanRequest& r
       << fmt(out.path_length_rad) << " rad, " << fmt(out.trajectory.duration_s) << " s";
   if (cell) msg << ", " << cell->tree_size() << " nodes, cell samples " << cell->cell_samples_ok() << "/"
                 << cell->cell_samples_tried();
-  msg << escape_note;
+  msg << escape_note << then_note;
   out.message = msg.str();
   out.planning_time_s = elapsed();
   return out;

@@ -48,6 +48,9 @@ struct PlanRequest {
   /// > 0: along the whole path the tool's z axis (the approach) stays within this angle of horizontal (a held
   /// book does not creep along the plates towards their tips); start and goal must meet it. 0 = no such constraint.
   double max_tool_pitch_rad = 0.0;
+  /// Pose goal: the straight (Cartesian) moves the arm makes after it, in order (tool poses in base). Goal IK
+  /// solutions from which tracking them leaves the joint limits are used only when there is no other.
+  std::vector<Eigen::Isometry3d> then_poses;
   double time_budget_s = 1.0;             ///< planning time limit (wall clock)
   std::string planner;                    ///< "CellBiRRT", "RRTConnect", "BiTRRT"; "" = default
   uint64_t seed = 1;                      ///< random seed (same request + seed -> same path)
@@ -82,6 +85,9 @@ struct MotionPlannerParams {
   /// exact shapes) to the nearest valid state found within this joint-space distance. 0: such a start fails.
   double start_escape_max_rad = 0.0;
   int start_escape_attempts = 200;         ///< random directions tried, at radii growing to start_escape_max_rad
+  double then_step_m = 0.005;              ///< then_poses are tracked by IK in steps of this length ...
+  double then_step_rad = 0.02;             ///< ... and of this rotation
+  double then_limit_margin_rad = 0.02;     ///< every tracked posture keeps this far from the joint limits
   Eigen::VectorXd max_velocity;            ///< rad/s per joint (trajectory)
   Eigen::VectorXd max_acceleration;        ///< rad/s^2 per joint (trajectory)
   double sample_period_s = 0.02;           ///< trajectory sample period

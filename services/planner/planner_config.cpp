@@ -91,6 +91,9 @@ PlannerSettings PlannerSettings::from_config(const Config& root) {
   p.goal_limit_margin_rad = pl.get_double("goal_limit_margin_rad", 0.0, 1.0);
   p.start_escape_max_rad = pl.get_double("start_escape_max_rad", 0.0, 1.0);
   p.start_escape_attempts = pl.get_int("start_escape_attempts", 1, 100000);
+  p.then_step_m = pl.get_double("then_step_m", 1e-4, 0.1);
+  p.then_step_rad = pl.get_double("then_step_rad", 1e-4, 0.5);
+  p.then_limit_margin_rad = pl.get_double("then_limit_margin_rad", 0.0, 0.5);
   p.max_velocity = vecn(pl, "max_velocity_rad_s", n);
   p.max_acceleration = vecn(pl, "max_acceleration_rad_s2", n);
   for (size_t k = 0; k < n; ++k) {

@@ -91,6 +91,17 @@ plan_result_t PlannerNode::process(const plan_request_t& req) const {
     if (!req.goal_pose.frame.empty() && req.goal_pose.frame != "base")
       return invalid("goal_pose is in frame '" + req.goal_pose.frame + "'; give it in 'base'");
   }
+  if (req.num_then_poses < 0 || static_cast<size_t>(req.num_then_poses) != req.then_poses.size())
+    return invalid("num_then_poses " + std::to_string(req.num_then_poses) + " differs from then_poses' length");
+  if (req.num_then_poses > 0 && req.goal_type != plan_request_t::POSE)
+    return invalid("then_poses need a POSE goal (they are tracked from its IK solutions)");
+  for (size_t i = 0; i < req.then_poses.size(); ++i) {
+    if (!is_valid_pose(req.then_poses[i]))
+      return invalid("then_poses[" + std::to_string(i) + "] is not a rigid transform (NaN or non-unit quaternion)");
+    if (!req.then_poses[i].frame.empty() && req.then_poses[i].frame != "base")
+      return invalid("then_poses[" + std::to_string(i) + "] is in frame '" + req.then_poses[i].frame +
+                     "'; give it in 'base'");
+  }
   if (!std::isfinite(req.time_budget_s) || req.time_budget_s < 0) return invalid("time_budget_s must be >= 0 (0 = default)");
   if (req.time_budget_s > settings_.max_time_budget_s)
     return invalid("time_budget_s " + std::to_string(req.time_budget_s) + " exceeds planner.max_time_budget_s " +
@@ -109,6 +120,7 @@ plan_result_t PlannerNode::process(const plan_request_t& req) const {
   r.position_tolerance_m = req.position_tolerance_m;
   r.orientation_tolerance_rad = req.orientation_tolerance_rad;
   r.keep_orientation = req.keep_orientation;
+  for (const pose_t& p : req.then_poses) r.then_poses.push_back(pose_to_isometry(p));
   if (req.holding_book) {
     r.max_tool_tilt_rad = settings_.held_book.max_tilt_rad;
     r.max_tool_pitch_rad = settings_.held_book.max_pitch_rad;

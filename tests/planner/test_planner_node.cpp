@@ -28,6 +28,7 @@ plan_request_t joint_request(const std::vector<double>& start, const std::vector
   r.time_budget_s = 1.0;
   r.holding_book = false;
   r.held_book_size_m[0] = r.held_book_size_m[1] = r.held_book_size_m[2] = 0.0;
+  r.num_then_poses = 0;
   return r;
 }
 
@@ -114,6 +115,28 @@ TEST_F(PlannerNodeTest, BadRequestsAreAnsweredWithReasons) {
   r = joint_request(kHome, kUp);
   r.start_joints.pop_back();
   EXPECT_EQ(node_.process(r).failure, plan_result_t::INVALID_REQUEST);
+
+  // then_poses: a count that differs from the list, a JOINTS goal with them, a NaN pose, another frame.
+  r = joint_request(kHome, kUp);
+  r.num_then_poses = 2;
+  out = node_.process(r);
+  EXPECT_EQ(out.failure, plan_result_t::INVALID_REQUEST);
+  EXPECT_NE(out.message.find("num_then_poses"), std::string::npos) << out.message;
+  r = joint_request(kHome, kUp);
+  r.then_poses.push_back(isometry_to_pose(Eigen::Isometry3d::Identity(), "base", "gripper", 0));
+  r.num_then_poses = 1;
+  out = node_.process(r);
+  EXPECT_EQ(out.failure, plan_result_t::INVALID_REQUEST);
+  EXPECT_NE(out.message.find("POSE goal"), std::string::npos) << out.message;
+  r.goal_type = plan_request_t::POSE;
+  r.then_poses[0].position[1] = NAN;
+  out = node_.process(r);
+  EXPECT_EQ(out.failure, plan_result_t::INVALID_REQUEST);
+  EXPECT_NE(out.message.find("then_poses[0]"), std::string::npos) << out.message;
+  r.then_poses[0] = isometry_to_pose(Eigen::Isometry3d::Identity(), "cart", "gripper", 0);
+  out = node_.process(r);
+  EXPECT_EQ(out.failure, plan_result_t::INVALID_REQUEST);
+  EXPECT_NE(out.message.find("'cart'"), std::string::npos) << out.message;
 }
 
 TEST_F(PlannerNodeTest, CartMarkerMovesTheCartBoxes) {
