@@ -68,6 +68,7 @@ ArbiterSettings ArbiterSettings::from_config(const Config& root) {
   s.tolerances.x = root.get_double("tolerances.x_m", 0.0001, 0.2);
   s.tolerances.max_rank = root.get_int("tolerances.max_rank", 1, 50);
   s.tolerances.p1_over_other_book = root.get<bool>("tolerances.p1_over_other_book");
+  s.tolerances.p1_p2_agreement_over_ps = root.get<bool>("tolerances.p1_p2_agreement_over_ps");
   s.tolerances.invalid_p1_depth_range = root.get_double("tolerances.invalid_p1_depth_range_m", 0.0, 0.36);
   s.tolerances.use_hand_corner = root.get<bool>("hand_corner.enabled");
   s.tolerances.hand_corner_max_y_from_p2 = root.get_double("hand_corner.max_y_from_p2_m", 0.0, 0.1);

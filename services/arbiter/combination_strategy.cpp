@@ -140,6 +140,12 @@ CombinationResult combine(const CombinationInputs& in, const CombinationToleranc
     r.steps.push_back(step("P2.y vs " + ref_name + ".y", dy, tol.y, true,
                            "P2.y valid: " + ref_name + " lies right of P2 and BwH already delivered the right-most "
                            "region"));
+  } else if (!r.p1_valid && tol.p1_p2_agreement_over_ps && in.p1 && in.p1->allFinite() &&
+             std::abs(p2.y() - in.p1->y()) < tol.y) {
+    r.steps.push_back(step("P2.y vs P1.y (P1 failed the PS check)", p2.y() - in.p1->y(), tol.y, true,
+                           "P2.y valid: " + mm(dy) +
+                               " right of PS, but P1 agrees with it: both sensors put the book "
+                               "right of where the last grasp left it (PS is stale)"));
   } else {
     const int next = in.p2_rank + 1;
     if (next >= tol.max_rank) {

@@ -23,6 +23,10 @@ struct CombinationTolerances {
   /// the corner of a taller left neighbour, not of the book P1 (checked against PS) belongs to;
   /// GP is then P1. False applies the paper's rules alone, which accept such a P2 in both axes.
   bool p1_over_other_book = true;
+  /// Not in the paper: a P2 more than `y` right of PS (the paper: a false region, try the next) is accepted in Y
+  /// when a P1 that failed the PS check lies within `y` of it: two sensors put the right-most book there, right of
+  /// where the last grasp's PS says (a book the failed attempt dragged right, whose next region does not exist).
+  bool p1_p2_agreement_over_ps = true;
   /// Not in the paper: a P1 that failed the check against PS still gives GP.z when it lies within this of the
   /// cart model's front plane (front_z_fallback): its book's fore-edge stands about as deep as the target's
   /// (flush, or pushed back with it by an earlier grasp's left plate), which the model's constant does not know.

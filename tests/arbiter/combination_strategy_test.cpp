@@ -82,6 +82,13 @@ const Case kCases[] = {
     // No valid P1, P2 right of PS beyond tolerance: next region.
     {"no_p1_p2_right_of_ps", {}, kPs, V(0.09, 0.130, 0.45), 0, 0.41, GraspOutcome::kNextRegion, false, V::Zero(), 1,
      "next region"},
+    // Not in the paper: P1 failed the PS check (7 cm right of it), P2 6.5 cm right of PS but 5 mm from P1: both
+    // sensors see the book there; P2.y accepted, Z as without a valid P1 (the cart model here).
+    {"p1_invalid_p2_agrees_right_of_ps", V(0.10, 0.170, 0.40), kPs, V(0.11, 0.165, 0.45), 0, 0.42,
+     GraspOutcome::kGrasp, false, V(0.11, 0.165, 0.42), 0, "cart model"},
+    // The same P2 with a P1 3.5 cm from it: no agreement, the paper's false region.
+    {"p1_invalid_p2_right_of_ps_away_from_p1", V(0.10, 0.200, 0.40), kPs, V(0.11, 0.165, 0.45), 0, 0.42,
+     GraspOutcome::kNextRegion, false, V::Zero(), 1, "next region"},
     // BwH failed: no P2.
     {"no_p2", V(0.10, 0.105, 0.40), kPs, {}, 0, {}, GraspOutcome::kNoGrasp, true, V::Zero(), 0, "did not converge"},
     {"p2_nan", V(0.10, 0.105, 0.40), kPs, V(0.1, kNan, 0.4), 0, {}, GraspOutcome::kNoGrasp, true, V::Zero(), 0,
@@ -128,6 +135,20 @@ TEST_P(CombinationStrategy, Branch) {
 
 INSTANTIATE_TEST_SUITE_P(Paper, CombinationStrategy, testing::ValuesIn(kCases),
                          [](const testing::TestParamInfo<Case>& i) { return std::string(i.param.name); });
+
+TEST(CombinationStrategy, TheP1P2AgreementRuleCanBeSwitchedOffForThePapersRules) {
+  CombinationTolerances paper = kTol;
+  paper.p1_p2_agreement_over_ps = false;
+  CombinationInputs in;
+  in.p1 = V(0.10, 0.170, 0.40);
+  in.ps = kPs;
+  in.p2 = V(0.11, 0.165, 0.45);
+  in.front_z_fallback = 0.42;
+  EXPECT_EQ(outcome_name(combine(in, kTol).outcome), outcome_name(GraspOutcome::kGrasp));
+  const CombinationResult r = combine(in, paper);
+  EXPECT_EQ(outcome_name(r.outcome), outcome_name(GraspOutcome::kNextRegion));
+  EXPECT_EQ(r.next_rank, 1);
+}
 
 TEST(CombinationStrategy, TheLeftNeighbourRuleCanBeSwitchedOffForThePapersRules) {
   CombinationTolerances paper = kTol;
