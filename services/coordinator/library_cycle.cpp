@@ -818,7 +818,7 @@ void LibraryCycle::enter(CycleState s) {
     const auto handed =
         std::count_if(progress_.moved.begin(), progress_.moved.end(), [](const MovedBook& b) { return b.handed_over; });
     message_ =
-        "upper shelf empty: " + std::to_string(progress_.books_moved) + " books moved" +
+        "upper shelf done: " + std::to_string(progress_.books_moved) + " books moved" +
         (handed > 0 ? " (" + std::to_string(handed) + " of them too tall, left to the librarian on the holder)" : "") +
         (message_.empty() ? "" : " (" + message_ + ")");
   }
@@ -985,7 +985,9 @@ bool LibraryCycle::stripe_left_limit_passed() {
          ": its stripe end is out of the servo's reach");
     return true;
   }
-  message_ = where + ": no book right of it, and BwS sees none: the upper shelf is empty within the arm's reach";
+  // Books lying flat (fallen when their neighbours went) hide neither the stripe nor stand as BwS fronts: they stay.
+  message_ = where + ": no standing book right of it, and BwS sees none: no book left that the arm can take (books "
+             "lying flat, if any, are left for the librarian)";
   progress_.finished = true;
   succeed(CycleState::kPark);
   return true;

@@ -545,7 +545,8 @@ TEST(LibraryCycle, AFreeStripePastTheLeftLimitEndsTheTaskWhenBwsSeesNoBook) {
   w.run(cycle, [&] { return done_or_aborted(cycle); });
   ASSERT_EQ(cycle.state(), CycleState::kDone) << cycle.status().message;
   EXPECT_NE(cycle.status().message.find("stripe_left_limit_y_m"), std::string::npos) << cycle.status().message;
-  EXPECT_NE(cycle.status().message.find("empty within the arm's reach"), std::string::npos) << cycle.status().message;
+  EXPECT_NE(cycle.status().message.find("no book left that the arm can take"), std::string::npos)
+      << cycle.status().message;
   EXPECT_EQ(count(w.states, "SERVO_STRIPE"), 1);
   EXPECT_EQ(slice(w.states, "SERVO_STRIPE", 3), (std::vector<std::string>{"SERVO_STRIPE", "PARK", "DONE"}));
   // The TCP went no further left than one 10 ms tick past the limit.
