@@ -136,14 +136,20 @@ TEST_P(CombinationStrategy, Branch) {
 INSTANTIATE_TEST_SUITE_P(Paper, CombinationStrategy, testing::ValuesIn(kCases),
                          [](const testing::TestParamInfo<Case>& i) { return std::string(i.param.name); });
 
+/// P1, PS = kPs, P2 and the model's front plane for the switched-off rules below.
+CombinationInputs corner_inputs(const V& p1, const V& p2, std::optional<double> front_z = {}) {
+  CombinationInputs in;
+  in.p1 = p1;
+  in.ps = kPs;
+  in.p2 = p2;
+  in.front_z_fallback = front_z;
+  return in;
+}
+
 TEST(CombinationStrategy, TheP1P2AgreementRuleCanBeSwitchedOffForThePapersRules) {
   CombinationTolerances paper = kTol;
   paper.p1_p2_agreement_over_ps = false;
-  CombinationInputs in;
-  in.p1 = V(0.10, 0.170, 0.40);
-  in.ps = kPs;
-  in.p2 = V(0.11, 0.165, 0.45);
-  in.front_z_fallback = 0.42;
+  const CombinationInputs in = corner_inputs(V(0.10, 0.170, 0.40), V(0.11, 0.165, 0.45), 0.42);
   EXPECT_EQ(outcome_name(combine(in, kTol).outcome), outcome_name(GraspOutcome::kGrasp));
   const CombinationResult r = combine(in, paper);
   EXPECT_EQ(outcome_name(r.outcome), outcome_name(GraspOutcome::kNextRegion));
@@ -153,10 +159,7 @@ TEST(CombinationStrategy, TheP1P2AgreementRuleCanBeSwitchedOffForThePapersRules)
 TEST(CombinationStrategy, TheLeftNeighbourRuleCanBeSwitchedOffForThePapersRules) {
   CombinationTolerances paper = kTol;
   paper.p1_over_other_book = false;
-  CombinationInputs in;
-  in.p1 = V(0.10, 0.105, 0.40);
-  in.ps = kPs;
-  in.p2 = V(0.13, 0.085, 0.45);
+  const CombinationInputs in = corner_inputs(V(0.10, 0.105, 0.40), V(0.13, 0.085, 0.45));
   const CombinationResult r = combine(in, paper);
   EXPECT_EQ(r.outcome, GraspOutcome::kGrasp);
   EXPECT_TRUE(r.gp.isApprox(V(0.13, 0.085, 0.40), 1e-12)) << r.gp.transpose();
