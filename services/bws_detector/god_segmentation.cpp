@@ -3,10 +3,10 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <limits>
 #include <numeric>
 #include <stdexcept>
-#include <tuple>
 #include <vector>
 
 #include <Eigen/Eigenvalues>
@@ -197,23 +197,58 @@ Plane fit_plane_closed_form(const Sums& s) {
   return plane;
 }
 
-/// Removes repeated edges (lo << 32 | hi, 1 <= lo < hi <= count) in O(E + count) by a counting sort on
-/// lo; the order becomes by lo, then by first occurrence (the merging needs the set only: its candidates
-/// are sorted by (distance, a, b)).
-void unique_edges(std::vector<uint64_t>& edges, int count, std::vector<uint64_t>& tmp, std::vector<int>& start,
-                  std::vector<int>& stamp) {
+/// One stable counting-sort pass of edges (lo << 32 | hi, 1 <= lo, hi <= count) from `in` to `out` by lo
+/// (`by_lo`) or by hi. `start` is scratch.
+void counting_pass(const std::vector<uint64_t>& in, std::vector<uint64_t>& out, int count, bool by_lo,
+                   std::vector<int>& start) {
+  const int shift = by_lo ? 32 : 0;
   start.assign(size_t(count) + 2, 0);
-  for (const uint64_t e : edges) ++start[size_t(e >> 32) + 1];
+  for (const uint64_t e : in) ++start[size_t((e >> shift) & 0xffffffffu) + 1];
   for (size_t i = 1; i < start.size(); ++i) start[i] += start[i - 1];
-  tmp.resize(edges.size());
-  for (const uint64_t e : edges) tmp[size_t(start[size_t(e >> 32)]++)] = e;
-  stamp.assign(size_t(count) + 1, 0);
-  edges.clear();
-  for (const uint64_t e : tmp) {
-    const int lo = int(e >> 32), hi = int(e & 0xffffffffu);
-    if (stamp[size_t(hi)] == lo) continue;
-    stamp[size_t(hi)] = lo;
-    edges.push_back(e);
+  out.resize(in.size());
+  for (const uint64_t e : in) out[size_t(start[size_t((e >> shift) & 0xffffffffu)]++)] = e;
+}
+
+/// Sorts edges (lo << 32 | hi, 1 <= lo, hi <= count) by (lo, hi) and removes repeated ones, in O(E + count)
+/// by two counting-sort passes (hi, then lo). The sorted order makes the merge candidates come out sorted
+/// by (a, b), which their radix sort by distance keeps (sort_candidates).
+void sort_unique_edges(std::vector<uint64_t>& edges, int count, std::vector<uint64_t>& tmp, std::vector<int>& start) {
+  counting_pass(edges, tmp, count, false, start);
+  counting_pass(tmp, edges, count, true, start);
+  edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
+}
+
+/// A merge candidate: distance d >= +0 (its IEEE bits, which order as d does for non-negative doubles) and
+/// the pair (a << 32 | b, a < b). Sorted by (d_bits, ab) = by (d, a, b).
+struct Candidate {
+  uint64_t d_bits;
+  uint64_t ab;
+};
+
+/// Sorts candidates that are sorted by `ab` into (d_bits, ab) order: a stable LSD radix sort on d_bits in
+/// 11-bit digits, skipping the digits every candidate shares. `tmp` and `hist` are scratch.
+void sort_candidates(std::vector<Candidate>& c, std::vector<Candidate>& tmp, std::vector<uint32_t>& hist) {
+  constexpr int kBits = 11, kDigits = 6;
+  constexpr size_t kBuckets = size_t(1) << kBits;
+  constexpr uint64_t kMask = kBuckets - 1;
+  const size_t n = c.size();
+  if (n < 2) return;
+  hist.assign(kBuckets * kDigits, 0);
+  for (const Candidate& e : c)
+    for (int k = 0; k < kDigits; ++k) ++hist[size_t(k) * kBuckets + size_t((e.d_bits >> (k * kBits)) & kMask)];
+  tmp.resize(n);
+  for (int k = 0; k < kDigits; ++k) {
+    uint32_t* h = hist.data() + size_t(k) * kBuckets;
+    const int shift = k * kBits;
+    if (h[(c[0].d_bits >> shift) & kMask] == n) continue;  // one digit value: the pass would not move anything
+    uint32_t sum = 0;
+    for (size_t i = 0; i < kBuckets; ++i) {
+      const uint32_t v = h[i];
+      h[i] = sum;
+      sum += v;
+    }
+    for (const Candidate& e : c) tmp[h[(e.d_bits >> shift) & kMask]++] = e;
+    c.swap(tmp);
   }
 }
 
@@ -682,10 +717,11 @@ struct GodWorkspace {
   std::vector<Sums> mom, omom;
   RunImage ri;
   std::vector<uint64_t> edges, recent, edge_tmp, root_edges;
-  std::vector<int> edge_start, edge_stamp;
+  std::vector<int> edge_start;
   std::vector<Plane> planes, oplanes;
   std::vector<uint8_t> fitted;
-  std::vector<std::tuple<double, int, int>> cand;
+  std::vector<Candidate> cand, cand_tmp;
+  std::vector<uint32_t> cand_hist;
   std::vector<char> touched;
   std::vector<int> id_of_initial, id_of_root, root_of_id, todo, next_todo;
   std::vector<std::pair<int, int>> grown;
@@ -829,8 +865,8 @@ SegmentationResult segment_god(const cv::Mat& image, const cv::Mat& points, cons
   const size_t num_edges = size_t(out - edges.data());
   edges.resize(num_edges);
   std::vector<uint64_t>& edge_tmp = ws.edge_tmp;
-  std::vector<int>&edge_start = ws.edge_start, &edge_stamp = ws.edge_stamp;
-  unique_edges(edges, count, edge_tmp, edge_start, edge_stamp);
+  std::vector<int>& edge_start = ws.edge_start;
+  sort_unique_edges(edges, count, edge_tmp, edge_start);
 
   // Iterative merging: each round merges the closest admissible pairs, each region at most once,
   // then refits; until a round merges nothing.
@@ -861,7 +897,7 @@ SegmentationResult segment_god(const cv::Mat& image, const cv::Mat& points, cons
   const double cos_gate = std::cos(params.merge_max_angle_deg * M_PI / 180.0);
   const double gate_n = double(params.merge_angle_min_px);
   const double T = params.merge_distance;
-  std::vector<std::tuple<double, int, int>>& cand = ws.cand;
+  std::vector<Candidate>& cand = ws.cand;
   std::vector<char>& touched = ws.touched;
   touched.assign(size_t(count) + 1, 0);
   std::vector<uint64_t>& root_edges = ws.root_edges;
@@ -878,7 +914,7 @@ SegmentationResult segment_god(const cv::Mat& image, const cv::Mat& points, cons
       if (b < a) std::swap(a, b);
       root_edges.push_back((uint64_t(a) << 32) | uint64_t(b));
     }
-    unique_edges(root_edges, count, edge_tmp, edge_start, edge_stamp);
+    sort_unique_edges(root_edges, count, edge_tmp, edge_start);
     edges.swap(root_edges);  // adjacency between current roots only
     // Distance of the smaller region's points to the larger region's plane, with the orientation gate;
     // a negative value means "may not merge".
@@ -896,15 +932,20 @@ SegmentationResult segment_god(const cv::Mat& image, const cv::Mat& points, cons
     for (uint64_t e : edges) {
       const int a = int(e >> 32), b = int(e & 0xffffffffu);
       const double d = merge_cost(a, b);
-      if (d >= 0.0) cand.emplace_back(d, a, b);
+      if (d >= 0.0) {
+        uint64_t bits;
+        std::memcpy(&bits, &d, sizeof bits);
+        cand.push_back({bits, e});  // e = a << 32 | b
+      }
     }
     if (cand.empty()) break;
     ++dbg.merge_rounds;
-    std::sort(cand.begin(), cand.end());
+    sort_candidates(cand, ws.cand_tmp, ws.cand_hist);
     // Closest pairs first; a pair whose regions changed in this round is re-checked with the current
     // planes (so a region can grow several times per round, keeping the rounds few).
     int merged_this_round = 0;
-    for (const auto& [d0, a0, b0] : cand) {
+    for (const Candidate& c : cand) {
+      const int a0 = int(c.ab >> 32), b0 = int(c.ab & 0xffffffffu);
       const int a = uf.find(a0), b = uf.find(b0);
       if (a == b) continue;
       if ((a != a0 || b != b0 || touched[size_t(a)] || touched[size_t(b)]) && merge_cost(a, b) < 0.0) continue;
