@@ -12,6 +12,7 @@
 #include <Eigen/Eigenvalues>
 
 #include "common/config.h"
+#include "services/bws_detector/point_sums.h"
 
 #if defined(__SSE2__)
 #include <emmintrin.h>
@@ -68,86 +69,10 @@ struct UnionFind {
   }
 };
 
-/// Sums of a point set in double (count, sums, the six distinct products), accumulated point by
-/// point exactly as PointMoments::add does (same products, same order), in 80 bytes.
-struct Sums {
-  double n = 0.0, x = 0.0, y = 0.0, z = 0.0, xx = 0.0, xy = 0.0, xz = 0.0, yy = 0.0, yz = 0.0, zz = 0.0;
-  void add(double px, double py, double pz) {
-    n += 1.0;
-    x += px;
-    y += py;
-    z += pz;
-    xx += px * px;
-    xy += px * py;
-    xz += px * pz;
-    yy += py * py;
-    yz += py * pz;
-    zz += pz * pz;
-  }
-  void add(const Sums& o) {
-    n += o.n;
-    x += o.x;
-    y += o.y;
-    z += o.z;
-    xx += o.xx;
-    xy += o.xy;
-    xz += o.xz;
-    yy += o.yy;
-    yz += o.yz;
-    zz += o.zz;
-  }
-  PointMoments moments() const {
-    PointMoments m;
-    m.n = n;
-    m.sum = Eigen::Vector3d(x, y, z);
-    m.sum_outer << xx, xy, xz, xy, yy, yz, xz, yz, zz;
-    return m;
-  }
-};
-
-inline bool finite3(const cv::Vec3f& q) {
-  return std::isfinite(q[0]) && std::isfinite(q[1]) && std::isfinite(q[2]);
-}
-
-static_assert(sizeof(Sums) == 10 * sizeof(double), "Sums: ten contiguous doubles");
-
+/// Adds the merge-space points (x, y, v[x]) of the valid pixels x0..x1 of row y to `s` (PointSums::add, in order).
+inline void add_image_run(PointSums& s, const float* v, int x0, int x1, int y) {
 #if defined(__SSE2__)
-/// Sums::add of (px, py, pz) on five pairs of lanes [n, x] [y, z] [xx, xy] [xz, yy] [yz, zz]: every lane
-/// makes the scalar code's operation (IEEE double, no fused multiply-add), so the sums are the same bits.
-struct PackedSums {
-  __m128d nx, yz, xx_xy, xz_yy, yz_zz;
-  explicit PackedSums(const Sums& s)
-      : nx(_mm_loadu_pd(&s.n)),
-        yz(_mm_loadu_pd(&s.y)),
-        xx_xy(_mm_loadu_pd(&s.xx)),
-        xz_yy(_mm_loadu_pd(&s.xz)),
-        yz_zz(_mm_loadu_pd(&s.yz)) {}
-  void store(Sums& s) const {
-    _mm_storeu_pd(&s.n, nx);
-    _mm_storeu_pd(&s.y, yz);
-    _mm_storeu_pd(&s.xx, xx_xy);
-    _mm_storeu_pd(&s.xz, xz_yy);
-    _mm_storeu_pd(&s.yz, yz_zz);
-  }
-  /// one_x = [1, px], pyz = [py, pz].
-  void add(__m128d one_x, __m128d pyz) {
-    const __m128d px2 = _mm_unpackhi_pd(one_x, one_x);  // [px, px]
-    const __m128d pxy = _mm_shuffle_pd(one_x, pyz, 1);  // [px, py]
-    const __m128d pzy = _mm_shuffle_pd(pyz, pyz, 1);    // [pz, py]
-    const __m128d pz2 = _mm_unpackhi_pd(pyz, pyz);      // [pz, pz]
-    nx = _mm_add_pd(nx, one_x);
-    yz = _mm_add_pd(yz, pyz);
-    xx_xy = _mm_add_pd(xx_xy, _mm_mul_pd(px2, pxy));  // [px*px, px*py]
-    xz_yy = _mm_add_pd(xz_yy, _mm_mul_pd(pxy, pzy));  // [px*pz, py*py]
-    yz_zz = _mm_add_pd(yz_zz, _mm_mul_pd(pyz, pz2));  // [py*pz, pz*pz]
-  }
-};
-#endif
-
-/// Adds the merge-space points (x, y, v[x]) of the valid pixels x0..x1 of row y to `s` (Sums::add, in order).
-inline void add_image_run(Sums& s, const float* v, int x0, int x1, int y) {
-#if defined(__SSE2__)
-  PackedSums p(s);
+  PackedPointSums p(s);
   for (int x = x0; x <= x1; ++x)
     if (valid_value(v[x])) p.add(_mm_set_pd(double(x), 1.0), _mm_set_pd(double(v[x]), double(y)));
   p.store(s);
@@ -157,26 +82,13 @@ inline void add_image_run(Sums& s, const float* v, int x0, int x1, int y) {
 #endif
 }
 
-/// Adds the finite points q[x0..x1] to `s` (Sums::add, in order).
-inline void add_point_run(Sums& s, const cv::Vec3f* q, int x0, int x1) {
-#if defined(__SSE2__)
-  PackedSums p(s);
-  for (int x = x0; x <= x1; ++x)
-    if (finite3(q[x])) p.add(_mm_set_pd(double(q[x][0]), 1.0), _mm_set_pd(double(q[x][2]), double(q[x][1])));
-  p.store(s);
-#else
-  for (int x = x0; x <= x1; ++x)
-    if (finite3(q[x])) s.add(q[x][0], q[x][1], q[x][2]);
-#endif
-}
-
 /// The merge's plane of a segment: fit_plane(s.moments()) with the covariance's eigenvectors from
 /// Eigen's closed-form 3x3 solver (analytic eigenvalues, eigenvectors from cross products of rows)
 /// instead of its iterative one: ~5x cheaper; the normal can differ from fit_plane's in the last bits.
 /// Near-degenerate sets (second eigenvalue near the degeneracy threshold) and ill-conditioned ones
 /// (two smallest eigenvalues close, where the closed form loses accuracy) use fit_plane itself.
 /// Only the merge and growth use it; the output regions are described with fit_plane.
-Plane fit_plane_closed_form(const Sums& s) {
+Plane fit_plane_closed_form(const PointSums& s) {
   Plane plane;
   if (s.n < 3.0) return plane;
   const Eigen::Vector3d mean = Eigen::Vector3d(s.x, s.y, s.z) / s.n;
@@ -714,7 +626,7 @@ struct GodWorkspace {
   UnionFind cc_uf, uf;
   std::vector<int> remap;
   std::vector<uint8_t> run_values;
-  std::vector<Sums> mom, omom;
+  std::vector<PointSums> mom, omom;
   RunImage ri;
   std::vector<uint64_t> edges, recent, edge_tmp, root_edges;
   std::vector<int> edge_start;
@@ -796,10 +708,10 @@ SegmentationResult segment_god(const cv::Mat& image, const cv::Mat& points, cons
 
   // Moments of every initial segment in merge space and in the output points' space (raster order,
   // the same sums PointMoments::add would make). When the two spaces are one, one array serves both.
-  std::vector<Sums>& mom = ws.mom;
-  mom.assign(size_t(count) + 1, Sums());
-  if (!same) ws.omom.assign(size_t(count) + 1, Sums());
-  std::vector<Sums>& omom = same ? mom : ws.omom;
+  std::vector<PointSums>& mom = ws.mom;
+  mom.assign(size_t(count) + 1, PointSums());
+  if (!same) ws.omom.assign(size_t(count) + 1, PointSums());
+  std::vector<PointSums>& omom = same ? mom : ws.omom;
   // Run by run: a run's pixels are consecutive in its segment's raster order, so its sums are added
   // pixel by pixel into a local copy (the same additions in the same order, kept in registers).
   for (int y = 0; y < H; ++y) {

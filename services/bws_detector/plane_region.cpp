@@ -1,5 +1,7 @@
 #include "services/bws_detector/plane_region.h"
 
+#include "services/bws_detector/point_sums.h"
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -70,15 +72,56 @@ inline int run_end(const int* l, int x, int W) {
   return x1;
 }
 
-/// Moment sums as PointMoments::add makes them (same products, same order), the six distinct products.
+/// Per label: pixel count, bounding box, moment sums (PointSums: PointMoments::add's operations), extent.
 struct Acc {
   int pixels = 0;
   int x0 = std::numeric_limits<int>::max(), y0 = std::numeric_limits<int>::max(), x1 = -1, y1 = -1;
-  double n = 0.0, sx = 0.0, sy = 0.0, sz = 0.0, xx = 0.0, xy = 0.0, xz = 0.0, yy = 0.0, yz = 0.0, zz = 0.0;
-  Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
-  Eigen::Vector3d hi = Eigen::Vector3d::Constant(-std::numeric_limits<double>::infinity());
+  PointSums sums;
+  double lo[3] = {kInf, kInf, kInf};
+  double hi[3] = {-kInf, -kInf, -kInf};
   int first = -1;
+  static constexpr double kInf = std::numeric_limits<double>::infinity();
 };
+
+/// Adds the finite points p[x..x1-1] to `a`'s sums (in order) and extent (as cwiseMin / cwiseMax).
+inline void add_run(Acc& a, const cv::Vec3f* p, int x, int x1) {
+#if defined(__SSE2__)
+  // Lanes: the sums as PackedPointSums; the extent in [x, y] and [y, z] pairs. std::min(lo, v) is
+  // (v < lo ? v : lo) = _mm_min_pd(v, lo); std::max(hi, v) is (hi < v ? v : hi) = _mm_max_pd(v, hi).
+  PackedPointSums s(a.sums);
+  __m128d lo_xy = _mm_loadu_pd(a.lo), lo_yz = _mm_loadu_pd(a.lo + 1);
+  __m128d hi_xy = _mm_loadu_pd(a.hi), hi_yz = _mm_loadu_pd(a.hi + 1);
+  for (int i = x; i < x1; ++i) {
+    const cv::Vec3f& q = p[i];
+    if (!finite3(q)) continue;
+    const __m128d one_x = _mm_set_pd(double(q[0]), 1.0), pyz = _mm_set_pd(double(q[2]), double(q[1]));
+    s.add(one_x, pyz);
+    const __m128d pxy = _mm_shuffle_pd(one_x, pyz, 1);  // [x, y]
+    lo_xy = _mm_min_pd(pxy, lo_xy);
+    hi_xy = _mm_max_pd(pxy, hi_xy);
+    lo_yz = _mm_min_pd(pyz, lo_yz);
+    hi_yz = _mm_max_pd(pyz, hi_yz);
+  }
+  s.store(a.sums);
+  _mm_storeu_pd(a.lo, lo_xy);
+  _mm_storeh_pd(a.lo + 2, lo_yz);
+  _mm_storeu_pd(a.hi, hi_xy);
+  _mm_storeh_pd(a.hi + 2, hi_yz);
+#else
+  PointSums s = a.sums;
+  for (int i = x; i < x1; ++i) {
+    const cv::Vec3f& q = p[i];
+    if (!finite3(q)) continue;
+    const double v[3] = {q[0], q[1], q[2]};
+    s.add(v[0], v[1], v[2]);
+    for (int k = 0; k < 3; ++k) {
+      a.lo[k] = std::min(a.lo[k], v[k]);  // as cwiseMin / cwiseMax of finite values
+      a.hi[k] = std::max(a.hi[k], v[k]);
+    }
+  }
+  a.sums = s;
+#endif
+}
 
 SegmentationResult describe(const cv::Mat& labels, const cv::Mat& points, int min_pixels, bool in_place) {
   if (labels.type() != CV_32S) throw std::invalid_argument("describe_regions: labels must be CV_32S");
@@ -110,42 +153,7 @@ SegmentationResult describe(const cv::Mat& labels, const cv::Mat& points, int mi
         a.x1 = std::max(a.x1, x1 - 1);
         a.y0 = std::min(a.y0, y);
         a.y1 = std::max(a.y1, y);
-        double n = a.n, sx = a.sx, sy = a.sy, sz = a.sz, xx = a.xx, xy = a.xy, xz = a.xz, yy = a.yy, yz = a.yz,
-               zz = a.zz;
-        double lo0 = a.lo[0], lo1 = a.lo[1], lo2 = a.lo[2], hi0 = a.hi[0], hi1 = a.hi[1], hi2 = a.hi[2];
-        for (int i = x; i < x1; ++i) {
-          const cv::Vec3f& q = p[i];
-          if (!(std::isfinite(q[0]) && std::isfinite(q[1]) && std::isfinite(q[2]))) continue;
-          const double v0 = q[0], v1 = q[1], v2 = q[2];
-          n += 1.0;
-          sx += v0;
-          sy += v1;
-          sz += v2;
-          xx += v0 * v0;
-          xy += v0 * v1;
-          xz += v0 * v2;
-          yy += v1 * v1;
-          yz += v1 * v2;
-          zz += v2 * v2;
-          lo0 = std::min(lo0, v0);  // as cwiseMin / cwiseMax of finite values
-          lo1 = std::min(lo1, v1);
-          lo2 = std::min(lo2, v2);
-          hi0 = std::max(hi0, v0);
-          hi1 = std::max(hi1, v1);
-          hi2 = std::max(hi2, v2);
-        }
-        a.n = n;
-        a.sx = sx;
-        a.sy = sy;
-        a.sz = sz;
-        a.xx = xx;
-        a.xy = xy;
-        a.xz = xz;
-        a.yy = yy;
-        a.yz = yz;
-        a.zz = zz;
-        a.lo = Eigen::Vector3d(lo0, lo1, lo2);
-        a.hi = Eigen::Vector3d(hi0, hi1, hi2);
+        add_run(a, p, x, x1);
       }
       x = x1;
     }
@@ -160,10 +168,7 @@ SegmentationResult describe(const cv::Mat& labels, const cv::Mat& points, int mi
   for (int lab : order) {
     const Acc& a = acc[size_t(lab)];
     if (a.pixels < min_pixels) continue;
-    PointMoments m;
-    m.n = a.n;
-    m.sum = Eigen::Vector3d(a.sx, a.sy, a.sz);
-    m.sum_outer << a.xx, a.xy, a.xz, a.xy, a.yy, a.yz, a.xz, a.yz, a.zz;
+    const PointMoments m = a.sums.moments();
     const Plane plane = fit_plane(m);
     if (!plane.valid) continue;
     PlaneRegion r;
@@ -175,8 +180,8 @@ SegmentationResult describe(const cv::Mat& labels, const cv::Mat& points, int mi
     r.offset = plane.offset;
     r.centroid = m.sum / m.n;
     r.rms_residual = rms_distance(m, plane);
-    r.extent_min = a.lo;
-    r.extent_max = a.hi;
+    r.extent_min = Eigen::Vector3d(a.lo[0], a.lo[1], a.lo[2]);
+    r.extent_max = Eigen::Vector3d(a.hi[0], a.hi[1], a.hi[2]);
     remap[size_t(lab)] = r.label;
     out.regions.push_back(r);
   }
