@@ -856,7 +856,23 @@ SegmentationResult segment_god(const cv::Mat& image, const cv::Mat& points, cons
     // Closest pairs first; a pair whose regions changed in this round is re-checked with the current
     // planes (so a region can grow several times per round, keeping the rounds few).
     int merged_this_round = 0;
-    for (const Candidate& c : cand) {
+    // The candidates come in distance order, so their segments are all over the moment arrays (larger
+    // than the core's L2 cache): the segments of a candidate a few places ahead are prefetched.
+    constexpr size_t kAhead = 8;
+    for (size_t ci = 0; ci < cand.size(); ++ci) {
+      if (ci + kAhead < cand.size()) {
+        const uint64_t ab = cand[ci + kAhead].ab;
+        for (const size_t i : {size_t(ab >> 32), size_t(ab & 0xffffffffu)}) {
+          __builtin_prefetch(&uf.parent[i]);
+          __builtin_prefetch(&mom[i].n);
+          __builtin_prefetch(&mom[i].zz);
+          if (!same) {
+            __builtin_prefetch(&omom[i].n);
+            __builtin_prefetch(&omom[i].zz);
+          }
+        }
+      }
+      const Candidate& c = cand[ci];
       const int a0 = int(c.ab >> 32), b0 = int(c.ab & 0xffffffffu);
       const int a = uf.find(a0), b = uf.find(b0);
       if (a == b) continue;
