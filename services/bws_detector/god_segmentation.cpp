@@ -82,6 +82,57 @@ inline void add_image_run(PointSums& s, const float* v, int x0, int x1, int y) {
 #endif
 }
 
+/// add_image_run with the coordinate sums added per run: n, x, y, xx, xy and yy of pixel coordinates are
+/// integers, and a double adds integers below 2^53 without rounding, in any order. So when every such
+/// sum of the image stays below 2^53 (`exact_coordinate_sums`), their run totals give the bits of the
+/// pixel-by-pixel sums; only the sums with the value (z, xz, yz, zz) are added pixel by pixel, in order,
+/// with the scalar code's operations.
+inline void add_image_run_exact(PointSums& s, const float* v, int x0, int x1, int y) {
+  int64_t n = 0, sx = 0, sxx = 0;
+#if defined(__SSE2__)
+  __m128d z_xz = _mm_set_pd(s.xz, s.z), yz_zz = _mm_loadu_pd(&s.yz);
+  const __m128d vy = _mm_set_sd(double(y));
+  for (int x = x0; x <= x1; ++x) {
+    if (!valid_value(v[x])) continue;
+    ++n;
+    sx += x;
+    sxx += int64_t(x) * x;
+    const __m128d z2 = _mm_set1_pd(double(v[x]));                         // [z, z]
+    z_xz = _mm_add_pd(z_xz, _mm_mul_pd(_mm_set_pd(double(x), 1.0), z2));  // [1*z, x*z]
+    yz_zz = _mm_add_pd(yz_zz, _mm_mul_pd(_mm_unpacklo_pd(vy, z2), z2));   // [y*z, z*z]
+  }
+  _mm_storel_pd(&s.z, z_xz);
+  _mm_storeh_pd(&s.xz, z_xz);
+  _mm_storeu_pd(&s.yz, yz_zz);
+#else
+  const double py = double(y);
+  for (int x = x0; x <= x1; ++x) {
+    if (!valid_value(v[x])) continue;
+    ++n;
+    sx += x;
+    sxx += int64_t(x) * x;
+    const double pz = double(v[x]);
+    s.z += pz;
+    s.xz += double(x) * pz;
+    s.yz += py * pz;
+    s.zz += pz * pz;
+  }
+#endif
+  s.n += double(n);
+  s.x += double(sx);
+  s.y += double(int64_t(y) * n);
+  s.xx += double(sxx);
+  s.xy += double(int64_t(y) * sx);
+  s.yy += double(int64_t(y) * y * n);
+}
+
+/// True when every coordinate sum add_image_run_exact makes (of at most W * H pixels, coordinates below
+/// max(W, H)) stays below 2^53.
+inline bool exact_coordinate_sums(int W, int H) {
+  const double m = double(std::max(W, H));
+  return double(W) * double(H) * m * m < 9007199254740992.0;  // 2^53
+}
+
 /// The merge's plane of a segment: fit_plane(s.moments()) with the covariance's eigenvectors from
 /// Eigen's closed-form 3x3 solver (analytic eigenvalues, eigenvectors from cross products of rows)
 /// instead of its iterative one: ~5x cheaper; the normal can differ from fit_plane's in the last bits.
@@ -714,12 +765,15 @@ SegmentationResult segment_god(const cv::Mat& image, const cv::Mat& points, cons
   std::vector<PointSums>& omom = same ? mom : ws.omom;
   // Run by run: a run's pixels are consecutive in its segment's raster order, so its sums are added
   // pixel by pixel into a local copy (the same additions in the same order, kept in registers).
+  const bool exact = exact_coordinate_sums(W, H);
   for (int y = 0; y < H; ++y) {
     const float* v = image.ptr<float>(y);
     const cv::Vec3f* q = points.empty() ? nullptr : points.ptr<cv::Vec3f>(y);
     for (size_t i = row_start[size_t(y)]; i < row_start[size_t(y) + 1]; ++i) {
       const Run& r = runs[i];
-      if (image_space)
+      if (image_space && exact)
+        add_image_run_exact(mom[size_t(r.label)], v, r.x0, r.x1, y);
+      else if (image_space)
         add_image_run(mom[size_t(r.label)], v, r.x0, r.x1, y);
       else
         add_point_run(mom[size_t(r.label)], q, r.x0, r.x1);
