@@ -562,7 +562,13 @@ struct Run {
 struct RunImage {
   std::vector<Run> runs;
   std::vector<size_t> row_start;
+  /// Per run: kCoveredAbove / kCoveredBelow when a run of its segment in the row above / below spans
+  /// all its columns (and maybe more).
+  std::vector<uint8_t> cover;
 };
+
+/// RunImage::cover bits.
+constexpr uint8_t kCoveredAbove = 1, kCoveredBelow = 2;
 
 /// Last column of the run of `c[x]`'s value that starts at x (the row has W pixels).
 inline int run_end(const uint8_t* c, int x, int W) {
@@ -591,6 +597,7 @@ void connected_runs(const cv::Mat& cls, RunImage& ri, int* count, UnionFind& uf,
   std::vector<Run>& runs = ri.runs;
   runs.clear();
   values.clear();
+  ri.cover.clear();
   uf.parent.clear();
   ri.row_start.resize(size_t(H) + 1);
   for (int y = 0; y < H; ++y) {
@@ -603,6 +610,7 @@ void connected_runs(const cv::Mat& cls, RunImage& ri, int* count, UnionFind& uf,
         const int id = int(runs.size());
         runs.push_back({x, x1, id});
         values.push_back(c[x]);
+        ri.cover.push_back(0);
         uf.parent.push_back(id);
       }
       x = x1 + 1;
@@ -613,7 +621,11 @@ void connected_runs(const cv::Mat& cls, RunImage& ri, int* count, UnionFind& uf,
     for (size_t i = i0; i < runs.size(); ++i) {
       while (j < i0 && runs[j].x1 < runs[i].x0) ++j;
       for (size_t k = j; k < i0 && runs[k].x0 <= runs[i].x1; ++k)
-        if (values[k] == values[i]) uf.unite(int(k), int(i));
+        if (values[k] == values[i]) {
+          uf.unite(int(k), int(i));
+          if (runs[k].x0 <= runs[i].x0 && runs[k].x1 >= runs[i].x1) ri.cover[i] |= kCoveredAbove;
+          if (runs[i].x0 <= runs[k].x0 && runs[i].x1 >= runs[k].x1) ri.cover[k] |= kCoveredBelow;
+        }
     }
   }
   ri.row_start[size_t(H)] = runs.size();
@@ -785,7 +797,13 @@ SegmentationResult segment_god(const cv::Mat& image, const cv::Mat& points, cons
   // radius R. Found on runs (maximal horizontal pieces of one label): a run and the later runs of its
   // row that start within R of its end, and the runs of the next R rows that overlap its columns
   // widened by R. An edge is not pushed again while it is in a small direct-mapped cache of recent
-  // edges (most repeats come from the next rows); the rest of the repeats go in unique_edges.
+  // edges (most repeats come from the next rows); the rest of the repeats go in sort_unique_edges.
+  // Implied pairs are skipped: a run u of row y covered by a run u' of its segment in row y + 1
+  // (kCoveredBelow: u' spans u's columns) pairs with no run of rows y + 1..y + R that u' does not reach
+  // at one row less (u' is as near to it in columns), and likewise for a run k of row y + dy covered
+  // by a run of its segment in row y + dy - 1 (kCoveredAbove). By induction on dy every skipped pair is
+  // found at a smaller row distance, down to the pairs within one row, which are never skipped: the
+  // edge set is the same.
   const int R = params.adjacency_radius_px;
   std::vector<uint64_t>& edges = ws.edges;
   edges.resize(std::max(edges.capacity(), size_t(count) * 4 + 64));
@@ -797,12 +815,12 @@ SegmentationResult segment_god(const cv::Mat& image, const cv::Mat& points, cons
   uint64_t* out = edges.data();
   uint64_t* out_end = out + edges.size();
   uint64_t* const cache = recent.data();
-  const auto push = [&](int a, int b) {
+  const auto push = [&](int a, int b, bool implied) {
     const uint64_t lo = uint64_t(std::min(a, b)), hi = uint64_t(std::max(a, b));
     const uint64_t e = (lo << 32) | hi;
     uint64_t& slot = cache[size_t((e * 0x9E3779B97F4A7C15ull) >> (64 - kCacheBits))];
     const uint64_t old = slot;
-    const bool fresh = (old != e) & (a != b);
+    const bool fresh = (old != e) & (a != b) & !implied;
     *out = e;
     out += fresh;
     slot = fresh ? e : old;
@@ -814,17 +832,19 @@ SegmentationResult segment_god(const cv::Mat& image, const cv::Mat& points, cons
     }
   };
   const Run* const rn = runs.data();
+  const uint8_t* const cover = ri.cover.data();
   for (int y = 0; y < H; ++y) {
     const size_t i0 = row_start[size_t(y)], i1 = row_start[size_t(y) + 1];
     for (size_t i = i0; i < i1; ++i)
-      for (size_t k = i + 1; k < i1 && rn[k].x0 - rn[i].x1 <= R; ++k) push(rn[i].label, rn[k].label);
+      for (size_t k = i + 1; k < i1 && rn[k].x0 - rn[i].x1 <= R; ++k) push(rn[i].label, rn[k].label, false);
     for (int dy = 1; dy <= R && y + dy < H; ++dy) {
       size_t j = row_start[size_t(y + dy)];
       const size_t j1 = row_start[size_t(y + dy) + 1];
       for (size_t i = i0; i < i1; ++i) {
+        if (cover[i] & kCoveredBelow) continue;
         const Run u = rn[i];
         while (j < j1 && rn[j].x1 < u.x0 - R) ++j;  // u.x0 grows with i: j only moves forward
-        for (size_t k = j; k < j1 && rn[k].x0 <= u.x1 + R; ++k) push(u.label, rn[k].label);
+        for (size_t k = j; k < j1 && rn[k].x0 <= u.x1 + R; ++k) push(u.label, rn[k].label, cover[k] & kCoveredAbove);
       }
     }
   }
