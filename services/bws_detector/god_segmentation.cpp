@@ -908,7 +908,7 @@ SegmentationResult segment_god(const cv::Mat& image, const cv::Mat& points, cons
       const bool a_large = mom[size_t(a)].n >= mom[size_t(b)].n;
       const int L = a_large ? a : b, S = a_large ? b : a;
       if (mom[size_t(S)].n <= 0.0 || !plane(L).valid) return -1.0;
-      const double d = rms_distance(mom[size_t(S)].moments(), plane(L));
+      const double d = rms_distance(mom[size_t(S)], plane(L));
       if (!(d < T)) return -1.0;
       if (omom[size_t(a)].n >= gate_n && omom[size_t(b)].n >= gate_n && oplane(a).valid && oplane(b).valid &&
           std::fabs(oplane(a).normal.dot(oplane(b).normal)) < cos_gate)

@@ -32,11 +32,35 @@ Plane fit_plane(const PointMoments& m) {
   return plane;
 }
 
+namespace {
+
+/// Root-mean-square distance to `plane` of a point set given by its count n, sums s0..s2 and sums of
+/// products m(i, j): the operations in the order Eigen evaluated n . (M n) - 2 o n . s + o^2 n on this
+/// target (rows 0 and 1 of M n from the left, row 2 from the right), written out so that PointSums
+/// need not be turned into matrices and both forms give the same bits.
+template <typename M>
+double rms_distance_of(double n, double s0, double s1, double s2, const M& m, const Plane& plane) {
+  if (n <= 0.0) return 0.0;
+  const double n0 = plane.normal[0], n1 = plane.normal[1], n2 = plane.normal[2], o = plane.offset;
+  const double r0 = (m(0, 0) * n0 + m(0, 1) * n1) + m(0, 2) * n2;
+  const double r1 = (m(1, 0) * n0 + m(1, 1) * n1) + m(1, 2) * n2;
+  const double r2 = (m(2, 2) * n2 + m(2, 1) * n1) + m(2, 0) * n0;
+  const double q = (r0 * n0 + r1 * n1) + r2 * n2;
+  const double l = (s0 * n0 + s1 * n1) + s2 * n2;
+  const double sq = q - 2.0 * o * l + o * o * n;
+  return std::sqrt(std::max(0.0, sq / n));
+}
+
+}  // namespace
+
 double rms_distance(const PointMoments& m, const Plane& plane) {
-  if (m.n <= 0.0) return 0.0;
-  const Eigen::Vector3d& n = plane.normal;
-  const double sq = n.dot(m.sum_outer * n) - 2.0 * plane.offset * n.dot(m.sum) + plane.offset * plane.offset * m.n;
-  return std::sqrt(std::max(0.0, sq / m.n));
+  return rms_distance_of(m.n, m.sum[0], m.sum[1], m.sum[2], m.sum_outer, plane);
+}
+
+double rms_distance(const PointSums& s, const Plane& plane) {
+  const double p[3][3] = {{s.xx, s.xy, s.xz}, {s.xy, s.yy, s.yz}, {s.xz, s.yz, s.zz}};
+  return rms_distance_of(
+      s.n, s.x, s.y, s.z, [&](int i, int j) { return p[i][j]; }, plane);
 }
 
 cv::Mat image_space_points(const cv::Mat& image) {

@@ -58,6 +58,9 @@ struct PointSums {
 
 static_assert(sizeof(PointSums) == 10 * sizeof(double), "PointSums: ten contiguous doubles");
 
+/// rms_distance(s.moments(), plane) without the matrices (same bits).
+double rms_distance(const PointSums& s, const Plane& plane);
+
 /// True when the three coordinates of `q` are finite.
 inline bool finite3(const cv::Vec3f& q) {
   return std::isfinite(q[0]) && std::isfinite(q[1]) && std::isfinite(q[2]);
