@@ -997,9 +997,18 @@ SegmentationResult segment_god(const cv::Mat& image, const cv::Mat& points, cons
     todo.clear();
     int* lab = labels.ptr<int>(0);  // continuous (created above)
     Eigen::Vector3d v;
-    for (int y = 0; y < H; ++y)
-      for (int x = 0; x < W; ++x)
-        if (lab[y * W + x] == 0 && merge_point(x, y, &v)) todo.push_back(y * W + x);
+    // The unlabeled pixels are the gaps between the runs: visited in raster order, as a scan of the image.
+    for (int y = 0; y < H; ++y) {
+      int x = 0;
+      for (size_t i = row_start[size_t(y)];; ++i) {
+        const bool last = i == row_start[size_t(y) + 1];
+        const int gap_end = last ? W : runs[i].x0;
+        for (; x < gap_end; ++x)
+          if (merge_point(x, y, &v)) todo.push_back(y * W + x);
+        if (last) break;
+        x = runs[i].x1 + 1;
+      }
+    }
     for (int g = 0; g < params.boundary_growth_px && !todo.empty(); ++g) {
       grown.clear();
       for (const int idx : todo) {
