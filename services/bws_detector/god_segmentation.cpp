@@ -452,7 +452,11 @@ inline int hist_argmax(const Count8* h, int K) {
 /// One row of the voting with 8-bit counts and 32 lanes (up to 32 bins): the window's histogram is
 /// held in two registers (h0: lanes 0-15, h1: 16-31); the same sums and the same argmax (largest
 /// count, lowest bin on ties) as hist_add / hist_sub / hist_argmax. `col`: W column histograms of 32.
-inline void vote_row_32(const uint8_t* b, uint8_t* o, const uint8_t* col, int W, int r, int num_bins) {
+/// Lanes of h1 that may win: all, or all but lane 31 when it is the dummy lane of the non-voting pixels
+/// (see vote_clusters_into) and must not. Non-voting pixels get 255 (the argmax is made for every pixel
+/// and kept or not without a branch: which pixels vote is close to random).
+inline void vote_row_32(const uint8_t* b, uint8_t* o, const uint8_t* col, int W, int r, int num_bins,
+                        __m128i h1_lanes) {
   const auto ld = [&](int x, int half) {
     return _mm_loadu_si128(reinterpret_cast<const __m128i*>(col + size_t(x) * 32 + size_t(half) * 16));
   };
@@ -462,16 +466,18 @@ inline void vote_row_32(const uint8_t* b, uint8_t* o, const uint8_t* col, int W,
     h1 = _mm_add_epi8(h1, ld(x, 1));
   }
   for (int x = 0; x < W; ++x) {
-    if (b[x] < num_bins) {
-      __m128i mx = _mm_max_epu8(h0, h1);
+    {
+      const __m128i h1m = _mm_and_si128(h1, h1_lanes);
+      __m128i mx = _mm_max_epu8(h0, h1m);
       mx = _mm_max_epu8(mx, _mm_shuffle_epi32(mx, _MM_SHUFFLE(1, 0, 3, 2)));
       mx = _mm_max_epu8(mx, _mm_shuffle_epi32(mx, _MM_SHUFFLE(2, 3, 0, 1)));
       mx = _mm_max_epu8(mx,
                         _mm_shufflelo_epi16(_mm_shufflehi_epi16(mx, _MM_SHUFFLE(2, 3, 0, 1)), _MM_SHUFFLE(2, 3, 0, 1)));
       mx = _mm_max_epu8(mx, _mm_or_si128(_mm_srli_epi16(mx, 8), _mm_slli_epi16(mx, 8)));  // every lane: the max
       const unsigned m = unsigned(_mm_movemask_epi8(_mm_cmpeq_epi8(h0, mx))) |
-                         (unsigned(_mm_movemask_epi8(_mm_cmpeq_epi8(h1, mx))) << 16);
-      o[x] = uint8_t(__builtin_ctz(m));
+                         (unsigned(_mm_movemask_epi8(_mm_cmpeq_epi8(h1m, mx))) << 16);
+      const uint8_t k = uint8_t(__builtin_ctz(m));
+      o[x] = b[x] < num_bins ? k : uint8_t(255);
     }
     if (x + r + 1 < W) {
       h0 = _mm_add_epi8(h0, ld(x + r + 1, 0));
@@ -519,8 +525,18 @@ void vote_clusters_into(const cv::Mat& bins, int num_bins, int n, cv::Mat& out, 
   const int K = (num_bins + L - 1) / L * L;  // whole vectors
   using Count = C;
   col.assign(size_t(W) * size_t(K), 0);
+  // With 8-bit counts in 32 lanes and fewer than 32 bins, the non-voting pixels are counted in lane 31
+  // instead of being skipped by a branch (which pixels vote is close to random); lane 31 never wins.
+  const bool dummy_lane = sizeof(C) == 1 && K == 32 && num_bins < 32;
   auto col_update = [&](int y, int delta) {
     const uint8_t* b = bins.ptr<uint8_t>(y);
+    if (dummy_lane) {
+      for (int x = 0; x < W; ++x) {
+        Count& c = col[size_t(x) * 32 + (b[x] < num_bins ? b[x] : 31)];
+        c = Count(c + delta);
+      }
+      return;
+    }
     for (int x = 0; x < W; ++x)
       if (b[x] < num_bins) col[size_t(x) * size_t(K) + b[x]] = Count(col[size_t(x) * size_t(K) + b[x]] + delta);
   };
@@ -538,7 +554,9 @@ void vote_clusters_into(const cv::Mat& bins, int num_bins, int n, cv::Mat& out, 
     uint8_t* o = out.ptr<uint8_t>(y);
 #if defined(__SSE2__)
     if (sizeof(C) == 1 && K == 32) {  // the usual 17 bins: the histogram stays in two registers
-      vote_row_32(b, o, reinterpret_cast<const uint8_t*>(col.data()), W, r, num_bins);
+      const __m128i all = _mm_set1_epi8(char(-1));
+      vote_row_32(b, o, reinterpret_cast<const uint8_t*>(col.data()), W, r, num_bins,
+                  dummy_lane ? _mm_srli_si128(all, 1) : all);
       continue;
     }
 #endif
