@@ -133,6 +133,61 @@ inline bool exact_coordinate_sums(int W, int H) {
   return double(W) * double(H) * m * m < 9007199254740992.0;  // 2^53
 }
 
+/// Eigen's closed-form 3x3 symmetric eigensolver (SelfAdjointEigenSolver::computeDirect) cut to what the
+/// merge's plane uses: the eigenvalues, and on request the eigenvector of the smallest one. The same steps
+/// through Eigen's own computeRoots and extract_kernel, so the same bits; the eigenvectors of the two
+/// larger eigenvalues are not made unless the smallest one's comes from them.
+class DirectEigen {
+ public:
+  /// Eigenvalues of `mat` (its lower triangle), ascending, as computeDirect gives them.
+  explicit DirectEigen(const Eigen::Matrix3d& mat) {
+    const double shift = mat.trace() / 3.0;
+    scaled_ = mat.template selfadjointView<Eigen::Lower>();
+    scaled_.diagonal().array() -= shift;
+    const double scale = scaled_.cwiseAbs().maxCoeff();
+    if (scale > 0) scaled_ /= scale;
+    Direct::computeRoots(scaled_, scaled_values_);
+    eigenvalues = scaled_values_ * scale;
+    eigenvalues.array() += shift;
+  }
+  /// computeDirect's eigenvectors().col(0).
+  Eigen::Vector3d smallest_eigenvector() const {
+    const Eigen::Vector3d& ev = scaled_values_;
+    const double eps = Eigen::NumTraits<double>::epsilon();
+    if ((ev(2) - ev(0)) <= eps) return Eigen::Vector3d::UnitX();
+    double d0 = ev(2) - ev(1);
+    const double d1 = ev(1) - ev(0);
+    Eigen::Matrix3d tmp = scaled_;
+    Eigen::Vector3d col_k, col_l;
+    if (!(d0 > d1)) {  // k = 0: column 0 is the first kernel
+      tmp.diagonal().array() -= ev(0);
+      Direct::extract_kernel(tmp, col_k, col_l);
+      return col_k;
+    }
+    d0 = d1;  // k = 2, l = 0: column 0 is the second one
+    tmp.diagonal().array() -= ev(2);
+    Direct::extract_kernel(tmp, col_k, col_l);
+    if (d0 <= 2 * eps * d1) {
+      col_l -= col_k.dot(col_l) * col_l;
+      col_l.normalize();
+    } else {
+      tmp = scaled_;
+      tmp.diagonal().array() -= ev(0);
+      Eigen::Vector3d dummy;
+      Direct::extract_kernel(tmp, col_l, dummy);
+    }
+    return col_l;
+  }
+  /// Ascending eigenvalues.
+  Eigen::Vector3d eigenvalues;
+
+ private:
+  using Direct =
+      Eigen::internal::direct_selfadjoint_eigenvalues<Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>, 3, false>;
+  Eigen::Matrix3d scaled_;
+  Eigen::Vector3d scaled_values_;
+};
+
 /// The merge's plane of a segment: fit_plane(s.moments()) with the covariance's eigenvectors from
 /// Eigen's closed-form 3x3 solver (analytic eigenvalues, eigenvectors from cross products of rows)
 /// instead of its iterative one: ~5x cheaper; the normal can differ from fit_plane's in the last bits.
@@ -146,12 +201,11 @@ Plane fit_plane_closed_form(const PointSums& s) {
   Eigen::Matrix3d so;
   so << s.xx, s.xy, s.xz, s.xy, s.yy, s.yz, s.xz, s.yz, s.zz;
   const Eigen::Matrix3d cov = so / s.n - mean * mean.transpose();
-  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver;
-  solver.computeDirect(cov);
-  const Eigen::Vector3d ev = solver.eigenvalues();
+  const DirectEigen solver(cov);
+  const Eigen::Vector3d& ev = solver.eigenvalues;
   const double scale = std::max(1.0, ev(2));
   if (!ev.allFinite() || !(ev(1) > 1e-9 * scale) || !(ev(1) - ev(0) > 1e-6 * ev(2))) return fit_plane(s.moments());
-  Eigen::Vector3d n = solver.eigenvectors().col(0).normalized();
+  Eigen::Vector3d n = solver.smallest_eigenvector().normalized();
   if (!n.allFinite()) return fit_plane(s.moments());
   if (n.dot(mean) > 0.0) n = -n;
   plane.normal = n;
