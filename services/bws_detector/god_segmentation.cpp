@@ -323,10 +323,12 @@ void god_bins_of_image(const cv::Mat& image, int s, double flat_mgod_max, int B,
       __m128i k = _mm_cvttps_epi32(_mm_add_ps(_mm_div_ps(a, vw), half));
       k = _mm_sub_epi32(k, _mm_and_si128(_mm_cmpgt_epi32(k, vBm1), vB));  // k >= B: k -= B
       k = _mm_or_si128(_mm_and_si128(_mm_castps_si128(is_flat), vB), _mm_andnot_si128(_mm_castps_si128(is_flat), k));
-      alignas(16) int32_t kk[4];
-      _mm_store_si128(reinterpret_cast<__m128i*>(kk), k);
-      for (int i = 0; i < 4; ++i)
-        if (vmask & (1 << i)) b[x + i] = uint8_t(kk[i]);
+      // 255 where the pixel does not vote; the four bytes stored at once (0 <= k <= B <= 254).
+      k = _mm_or_si128(_mm_and_si128(_mm_castps_si128(votes), k),
+                       _mm_andnot_si128(_mm_castps_si128(votes), _mm_set1_epi32(255)));
+      k = _mm_packs_epi32(k, k);
+      const int32_t k4 = _mm_cvtsi128_si32(_mm_packus_epi16(k, k));
+      std::memcpy(b + x, &k4, 4);
     }
 #endif
     for (; x < image.cols - s; ++x) {
@@ -716,16 +718,27 @@ void connected_runs(const cv::Mat& cls, RunImage& ri, int* count, UnionFind& uf,
 /// `id[run.label]`, or run.label itself when `id` is null.
 void paint_runs(const RunImage& ri, cv::Size size, const int* id, cv::Mat& lab) {
   lab.create(size, CV_32S);
+  const int W = size.width;
   for (int y = 0; y < size.height; ++y) {
     int* l = lab.ptr<int>(y);
+    // Pixels x0..x1 get v, four at a time: a store may run past x1 (not past the row), into pixels
+    // that a later piece of the row overwrites.
+    const auto fill = [&](int x0, int x1, int v) {
+      int x = x0;
+#if defined(__SSE2__)
+      const __m128i vv = _mm_set1_epi32(v);
+      for (; x <= x1 && x + 4 <= W; x += 4) _mm_storeu_si128(reinterpret_cast<__m128i*>(l + x), vv);
+#endif
+      for (; x <= x1; ++x) l[x] = v;
+    };
     int x = 0;
     for (size_t i = ri.row_start[size_t(y)]; i < ri.row_start[size_t(y) + 1]; ++i) {
       const Run& r = ri.runs[i];
-      std::fill(l + x, l + r.x0, 0);
-      std::fill(l + r.x0, l + r.x1 + 1, id ? id[r.label] : r.label);
+      fill(x, r.x0 - 1, 0);
+      fill(r.x0, r.x1, id ? id[r.label] : r.label);
       x = r.x1 + 1;
     }
-    std::fill(l + x, l + size.width, 0);
+    fill(x, W - 1, 0);
   }
 }
 
