@@ -115,12 +115,12 @@ inline void add_run(Acc& a, const cv::Vec3f* p, int x, int x1) {
   PackedPointSums s(a.sums);
   __m128d lo_xy = _mm_loadu_pd(a.lo), lo_yz = _mm_loadu_pd(a.lo + 1);
   __m128d hi_xy = _mm_loadu_pd(a.hi), hi_yz = _mm_loadu_pd(a.hi + 1);
+  const __m128d one = _mm_set_sd(1.0);
   for (int i = x; i < x1; ++i) {
-    const cv::Vec3f& q = p[i];
-    if (!finite3(q)) continue;
-    const __m128d one_x = _mm_set_pd(double(q[0]), 1.0), pyz = _mm_set_pd(double(q[2]), double(q[1]));
-    s.add(one_x, pyz);
-    const __m128d pxy = _mm_shuffle_pd(one_x, pyz, 1);  // [x, y]
+    __m128d pxy, zz;
+    if (!load_finite_point(p[i], &pxy, &zz)) continue;
+    const __m128d pyz = _mm_shuffle_pd(pxy, zz, 1);  // [y, z]
+    s.add(_mm_unpacklo_pd(one, pxy), pyz);           // [1, x], [y, z]
     lo_xy = _mm_min_pd(pxy, lo_xy);
     hi_xy = _mm_max_pd(pxy, hi_xy);
     lo_yz = _mm_min_pd(pyz, lo_yz);

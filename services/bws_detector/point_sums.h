@@ -100,14 +100,32 @@ struct PackedPointSums {
     yz_zz = _mm_add_pd(yz_zz, _mm_mul_pd(pyz, pz2));  // [py*pz, pz*pz]
   }
 };
+
+/// Loads the point `q` as doubles [x, y] and [z, z]; false (and nothing loaded) if a coordinate is not
+/// finite (exponent bits all ones: the same test as finite3). Reads exactly the 12 bytes of `q`.
+inline bool load_finite_point(const cv::Vec3f& q, __m128d* xy, __m128d* zz) {
+  const __m128 fxy = _mm_loadl_pi(_mm_setzero_ps(), reinterpret_cast<const __m64*>(&q[0]));  // [x, y, 0, 0]
+  const __m128 fz = _mm_load_ss(&q[2]);                                                      // [z, 0, 0, 0]
+  const __m128i exp_mask = _mm_set1_epi32(0x7f800000);
+  const __m128i e = _mm_and_si128(_mm_castps_si128(_mm_movelh_ps(fxy, fz)), exp_mask);  // [x, y, z, 0]
+  if (_mm_movemask_epi8(_mm_cmpeq_epi32(e, exp_mask)) != 0) return false;
+  *xy = _mm_cvtps_pd(fxy);
+  const __m128d z = _mm_cvtss_sd(_mm_setzero_pd(), fz);
+  *zz = _mm_unpacklo_pd(z, z);
+  return true;
+}
 #endif
 
 /// Adds the finite points q[x0..x1] to `s` (PointSums::add, in order).
 inline void add_point_run(PointSums& s, const cv::Vec3f* q, int x0, int x1) {
 #if defined(__SSE2__)
   PackedPointSums p(s);
-  for (int x = x0; x <= x1; ++x)
-    if (finite3(q[x])) p.add(_mm_set_pd(double(q[x][0]), 1.0), _mm_set_pd(double(q[x][2]), double(q[x][1])));
+  const __m128d one = _mm_set_sd(1.0);
+  for (int x = x0; x <= x1; ++x) {
+    __m128d xy, zz;
+    if (!load_finite_point(q[x], &xy, &zz)) continue;
+    p.add(_mm_unpacklo_pd(one, xy), _mm_shuffle_pd(xy, zz, 1));  // [1, x], [y, z]
+  }
   p.store(s);
 #else
   for (int x = x0; x <= x1; ++x)
