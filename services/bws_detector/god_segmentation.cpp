@@ -476,73 +476,100 @@ inline int hist_argmax(const Count* h, int K) {
   }
   return 0;
 }
-inline void hist_add(Count8* h, const Count8* c, int K) {
-  for (int k = 0; k < K; k += 16) {
-    const __m128i a = _mm_loadu_si128(reinterpret_cast<const __m128i*>(h + k));
-    _mm_storeu_si128(reinterpret_cast<__m128i*>(h + k),
-                     _mm_add_epi8(a, _mm_loadu_si128(reinterpret_cast<const __m128i*>(c + k))));
-  }
-}
-inline void hist_sub(Count8* h, const Count8* c, int K) {
-  for (int k = 0; k < K; k += 16) {
-    const __m128i a = _mm_loadu_si128(reinterpret_cast<const __m128i*>(h + k));
-    _mm_storeu_si128(reinterpret_cast<__m128i*>(h + k),
-                     _mm_sub_epi8(a, _mm_loadu_si128(reinterpret_cast<const __m128i*>(c + k))));
-  }
-}
-/// As above for 8-bit counts (unsigned max).
-inline int hist_argmax(const Count8* h, int K) {
-  __m128i mx = _mm_loadu_si128(reinterpret_cast<const __m128i*>(h));
-  for (int k = 16; k < K; k += 16) mx = _mm_max_epu8(mx, _mm_loadu_si128(reinterpret_cast<const __m128i*>(h + k)));
-  mx = _mm_max_epu8(mx, _mm_srli_si128(mx, 8));
-  mx = _mm_max_epu8(mx, _mm_srli_si128(mx, 4));
-  mx = _mm_max_epu8(mx, _mm_srli_si128(mx, 2));
-  mx = _mm_max_epu8(mx, _mm_srli_si128(mx, 1));
-  mx = _mm_set1_epi8(char(_mm_cvtsi128_si32(mx) & 0xff));
-  for (int k = 0; k < K; k += 16) {
-    const int m = _mm_movemask_epi8(_mm_cmpeq_epi8(_mm_loadu_si128(reinterpret_cast<const __m128i*>(h + k)), mx));
-    if (m) return k + __builtin_ctz(unsigned(m));
-  }
-  return 0;
-}
-/// One row of the voting with 8-bit counts and 32 lanes (up to 32 bins): the window's histogram is
-/// held in two registers (h0: lanes 0-15, h1: 16-31); the same sums and the same argmax (largest
-/// count, lowest bin on ties) as hist_add / hist_sub / hist_argmax. `col`: W column histograms of 32.
-/// Lanes of h1 that may win: all, or all but lane 31 when it is the dummy lane of the non-voting pixels
-/// (see vote_clusters_into) and must not. Non-voting pixels get 255 (the argmax is made for every pixel
-/// and kept or not without a branch: which pixels vote is close to random).
-inline void vote_row_32(const uint8_t* b, uint8_t* o, const uint8_t* col, int W, int r, int num_bins,
-                        __m128i h1_lanes) {
-  const auto ld = [&](int x, int half) {
-    return _mm_loadu_si128(reinterpret_cast<const __m128i*>(col + size_t(x) * 32 + size_t(half) * 16));
+/// The voting with 8-bit counts (windows up to 15 x 15: n * n <= 225 votes), 16 pixels at a time: the
+/// column histograms are stored per bin (`colp`: num_bins planes of `stride` bytes, column x at x + r,
+/// zero columns around), updated by vector compares of a whole row of bins; the window count of bin k
+/// for 16 pixels is the sum of the 2r + 1 shifted loads of plane k; the argmax runs over the bins with a
+/// strict comparison (largest count, the lowest bin on ties, as hist_argmax). Non-voting pixels get 255.
+template <int kR>
+void vote_clusters_planar_r(const cv::Mat& bins, int num_bins, cv::Mat& out, std::vector<uint8_t>& colp) {
+  constexpr int r = kR;
+  const int W = bins.cols, H = bins.rows;
+  const size_t stride = size_t(W + 2 * r + 32) & ~size_t(15);
+  colp.assign(size_t(num_bins) * stride, 0);
+  uint8_t* const planes = colp.data();  // (a local: byte stores may alias the vector's members)
+  // Counts are at most 225: compared as signed bytes after flipping the sign bit.
+  const __m128i bias = _mm_set1_epi8(char(-128)), none = _mm_set1_epi8(char(-1));
+  // 16 bins of row y from column x (255 past the row's end).
+  const auto load_bins = [&](const uint8_t* b, int x) {
+    if (x + 16 <= W) return _mm_loadu_si128(reinterpret_cast<const __m128i*>(b + x));
+    alignas(16) uint8_t tmp[16];
+    std::fill(tmp, tmp + 16, uint8_t(255));
+    std::copy(b + x, b + W, tmp);
+    return _mm_load_si128(reinterpret_cast<const __m128i*>(tmp));
   };
-  __m128i h0 = _mm_setzero_si128(), h1 = _mm_setzero_si128();
-  for (int x = 0; x <= std::min(r, W - 1); ++x) {
-    h0 = _mm_add_epi8(h0, ld(x, 0));
-    h1 = _mm_add_epi8(h1, ld(x, 1));
+  // Column histograms += the bins of row `in`, -= those of row `out_row` (either may be -1: none).
+  const auto col_update = [&](int in, int out_row) {
+    const uint8_t* bi = in >= 0 ? bins.ptr<uint8_t>(in) : nullptr;
+    const uint8_t* bo = out_row >= 0 ? bins.ptr<uint8_t>(out_row) : nullptr;
+    for (int x = 0; x < W; x += 16) {
+      const __m128i vi = bi ? load_bins(bi, x) : none, vo = bo ? load_bins(bo, x) : none;
+      __m128i kk = _mm_setzero_si128();
+      for (int k = 0; k < num_bins; ++k, kk = _mm_sub_epi8(kk, none)) {  // kk: k in every lane
+        __m128i* c = reinterpret_cast<__m128i*>(planes + size_t(k) * stride + size_t(x + r));
+        // cmpeq gives -1 where the bin is k: subtracting it counts the pixel, adding it removes it.
+        const __m128i v = _mm_sub_epi8(_mm_loadu_si128(c), _mm_cmpeq_epi8(vi, kk));
+        _mm_storeu_si128(c, _mm_add_epi8(v, _mm_cmpeq_epi8(vo, kk)));
+      }
+    }
+  };
+  for (int y = 0; y <= std::min(r, H - 1); ++y) col_update(y, -1);
+  out.create(bins.size(), CV_8U);
+  for (int y = 0; y < H; ++y) {
+    if (y > 0) col_update(y + r < H ? y + r : -1, y - r - 1);
+    const uint8_t* b = bins.ptr<uint8_t>(y);
+    uint8_t* o = out.ptr<uint8_t>(y);
+    for (int x = 0; x < W; x += 16) {
+      // Window count of bin k for pixels x..x+15: columns x - r .. x + 15 + r (plane offsets x .. x + 2r).
+      const auto window = [&](int k) {
+        const uint8_t* c = planes + size_t(k) * stride + size_t(x);
+        __m128i sum = _mm_loadu_si128(reinterpret_cast<const __m128i*>(c));
+        for (int j = 1; j <= 2 * r; ++j)
+          sum = _mm_add_epi8(sum, _mm_loadu_si128(reinterpret_cast<const __m128i*>(c + j)));
+        return _mm_xor_si128(sum, bias);
+      };
+      __m128i best = window(0), arg = _mm_setzero_si128(), kk = _mm_setzero_si128();
+      for (int k = 1; k < num_bins; ++k) {
+        kk = _mm_sub_epi8(kk, none);  // k in every lane
+        const __m128i sb = window(k);
+        const __m128i gt = _mm_cmpgt_epi8(sb, best);
+        best = _mm_or_si128(_mm_and_si128(gt, sb), _mm_andnot_si128(gt, best));
+        arg = _mm_or_si128(_mm_and_si128(gt, kk), _mm_andnot_si128(gt, arg));
+      }
+      const __m128i vb = load_bins(b, x);
+      // Voting pixels have a bin < num_bins (<= 255): bins are unsigned, compared after flipping the sign bit.
+      const __m128i votes = _mm_cmplt_epi8(_mm_xor_si128(vb, bias), _mm_xor_si128(_mm_set1_epi8(char(num_bins)), bias));
+      const __m128i res = _mm_or_si128(_mm_and_si128(votes, arg), _mm_andnot_si128(votes, none));
+      if (x + 16 <= W) {
+        _mm_storeu_si128(reinterpret_cast<__m128i*>(o + x), res);
+      } else {
+        alignas(16) uint8_t tmp[16];
+        _mm_store_si128(reinterpret_cast<__m128i*>(tmp), res);
+        std::copy(tmp, tmp + (W - x), o + x);
+      }
+    }
   }
-  for (int x = 0; x < W; ++x) {
-    {
-      const __m128i h1m = _mm_and_si128(h1, h1_lanes);
-      __m128i mx = _mm_max_epu8(h0, h1m);
-      mx = _mm_max_epu8(mx, _mm_shuffle_epi32(mx, _MM_SHUFFLE(1, 0, 3, 2)));
-      mx = _mm_max_epu8(mx, _mm_shuffle_epi32(mx, _MM_SHUFFLE(2, 3, 0, 1)));
-      mx = _mm_max_epu8(mx,
-                        _mm_shufflelo_epi16(_mm_shufflehi_epi16(mx, _MM_SHUFFLE(2, 3, 0, 1)), _MM_SHUFFLE(2, 3, 0, 1)));
-      mx = _mm_max_epu8(mx, _mm_or_si128(_mm_srli_epi16(mx, 8), _mm_slli_epi16(mx, 8)));  // every lane: the max
-      const unsigned m = unsigned(_mm_movemask_epi8(_mm_cmpeq_epi8(h0, mx))) |
-                         (unsigned(_mm_movemask_epi8(_mm_cmpeq_epi8(h1m, mx))) << 16);
-      const uint8_t k = uint8_t(__builtin_ctz(m));
-      o[x] = b[x] < num_bins ? k : uint8_t(255);
-    }
-    if (x + r + 1 < W) {
-      h0 = _mm_add_epi8(h0, ld(x + r + 1, 0));
-      h1 = _mm_add_epi8(h1, ld(x + r + 1, 1));
-    }
-    if (x - r >= 0) {
-      h0 = _mm_sub_epi8(h0, ld(x - r, 0));
-      h1 = _mm_sub_epi8(h1, ld(x - r, 1));
-    }
+}
+
+/// vote_clusters_planar_r for the window's half size r (0..7).
+void vote_clusters_planar(const cv::Mat& bins, int num_bins, int r, cv::Mat& out, std::vector<uint8_t>& colp) {
+  switch (r) {
+    case 0:
+      return vote_clusters_planar_r<0>(bins, num_bins, out, colp);
+    case 1:
+      return vote_clusters_planar_r<1>(bins, num_bins, out, colp);
+    case 2:
+      return vote_clusters_planar_r<2>(bins, num_bins, out, colp);
+    case 3:
+      return vote_clusters_planar_r<3>(bins, num_bins, out, colp);
+    case 4:
+      return vote_clusters_planar_r<4>(bins, num_bins, out, colp);
+    case 5:
+      return vote_clusters_planar_r<5>(bins, num_bins, out, colp);
+    case 6:
+      return vote_clusters_planar_r<6>(bins, num_bins, out, colp);
+    default:
+      return vote_clusters_planar_r<7>(bins, num_bins, out, colp);
   }
 }
 #else
@@ -567,32 +594,17 @@ inline int hist_argmax(const C* h, int K) {
 
 namespace {
 
-/// vote_clusters into `out` (its buffer reused when it has the size and type), with the column
-/// histograms in `col` (capacity reused).
-/// (Counts in C: uint16_t always, uint8_t for windows up to 15 x 15.)
+/// The voting on per-pixel histograms of C counts: a window histogram slid along each row over the
+/// column histograms (`col`: K lanes per column).
 template <typename C>
-void vote_clusters_into(const cv::Mat& bins, int num_bins, int n, cv::Mat& out, std::vector<C>& col) {
-  if (bins.type() != CV_8U) throw std::invalid_argument("vote_clusters: bins must be CV_8U");
-  if (n < 1 || n % 2 == 0) throw std::invalid_argument("vote_clusters: window_size must be odd");
-  if (num_bins < 1 || num_bins > 255) throw std::invalid_argument("vote_clusters: num_bins must be in [1, 255]");
-  if (sizeof(C) == 1 && n > 15) throw std::invalid_argument("vote_clusters: 8-bit counts need window_size <= 15");
-  const int W = bins.cols, H = bins.rows, r = n / 2;
+void vote_clusters_histograms(const cv::Mat& bins, int num_bins, int r, cv::Mat& out, std::vector<C>& col) {
+  const int W = bins.cols, H = bins.rows;
   constexpr int L = 16 / int(sizeof(C));     // lanes per vector
   const int K = (num_bins + L - 1) / L * L;  // whole vectors
   using Count = C;
   col.assign(size_t(W) * size_t(K), 0);
-  // With 8-bit counts in 32 lanes and fewer than 32 bins, the non-voting pixels are counted in lane 31
-  // instead of being skipped by a branch (which pixels vote is close to random); lane 31 never wins.
-  const bool dummy_lane = sizeof(C) == 1 && K == 32 && num_bins < 32;
   auto col_update = [&](int y, int delta) {
     const uint8_t* b = bins.ptr<uint8_t>(y);
-    if (dummy_lane) {
-      for (int x = 0; x < W; ++x) {
-        Count& c = col[size_t(x) * 32 + (b[x] < num_bins ? b[x] : 31)];
-        c = Count(c + delta);
-      }
-      return;
-    }
     for (int x = 0; x < W; ++x)
       if (b[x] < num_bins) col[size_t(x) * size_t(K) + b[x]] = Count(col[size_t(x) * size_t(K) + b[x]] + delta);
   };
@@ -608,14 +620,6 @@ void vote_clusters_into(const cv::Mat& bins, int num_bins, int n, cv::Mat& out, 
     }
     const uint8_t* b = bins.ptr<uint8_t>(y);
     uint8_t* o = out.ptr<uint8_t>(y);
-#if defined(__SSE2__)
-    if (sizeof(C) == 1 && K == 32) {  // the usual 17 bins: the histogram stays in two registers
-      const __m128i all = _mm_set1_epi8(char(-1));
-      vote_row_32(b, o, reinterpret_cast<const uint8_t*>(col.data()), W, r, num_bins,
-                  dummy_lane ? _mm_srli_si128(all, 1) : all);
-      continue;
-    }
-#endif
     std::fill(hist, hist + K, Count(0));
     for (int x = 0; x <= std::min(r, W - 1); ++x) hist_add(hist, &col[size_t(x) * size_t(K)], K);
     for (int x = 0; x < W; ++x) {
@@ -624,6 +628,26 @@ void vote_clusters_into(const cv::Mat& bins, int num_bins, int n, cv::Mat& out, 
       if (x - r >= 0) hist_sub(hist, &col[size_t(x - r) * size_t(K)], K);
     }
   }
+}
+
+/// vote_clusters into `out` (its buffer reused when it has the size and type), with the column
+/// histograms in `col` (capacity reused).
+/// (Counts in C: uint16_t always, uint8_t for windows up to 15 x 15.)
+template <typename C>
+void vote_clusters_into(const cv::Mat& bins, int num_bins, int n, cv::Mat& out, std::vector<C>& col) {
+  if (bins.type() != CV_8U) throw std::invalid_argument("vote_clusters: bins must be CV_8U");
+  if (n < 1 || n % 2 == 0) throw std::invalid_argument("vote_clusters: window_size must be odd");
+  if (num_bins < 1 || num_bins > 255) throw std::invalid_argument("vote_clusters: num_bins must be in [1, 255]");
+  if (sizeof(C) == 1 && n > 15) throw std::invalid_argument("vote_clusters: 8-bit counts need window_size <= 15");
+#if defined(__SSE2__)
+  if constexpr (sizeof(C) == 1) {
+    vote_clusters_planar(bins, num_bins, n / 2, out, col);
+  } else {
+    vote_clusters_histograms(bins, num_bins, n / 2, out, col);
+  }
+#else
+  vote_clusters_histograms(bins, num_bins, n / 2, out, col);
+#endif
 }
 
 /// A maximal horizontal run of one initial segment in a row: columns x0..x1 of segment `label`.
