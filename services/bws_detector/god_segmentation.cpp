@@ -687,9 +687,8 @@ inline int run_end(const uint8_t* c, int x, int W) {
 /// 4-connected components of equal values of `cls` (CV_8U, 255 = background) as runs: the runs of each
 /// row, joined to the runs of the row above that share a column and the value (union-find on runs),
 /// labelled 1..count in raster order of the components' first pixels (= of their first runs).
-/// `uf`, `remap` and `values` are scratch (capacity reused).
-void connected_runs(const cv::Mat& cls, RunImage& ri, int* count, UnionFind& uf, std::vector<int>& remap,
-                    std::vector<uint8_t>& values) {
+/// `uf` and `values` are scratch (capacity reused).
+void connected_runs(const cv::Mat& cls, RunImage& ri, int* count, UnionFind& uf, std::vector<uint8_t>& values) {
   if (cls.type() != CV_8U) throw std::invalid_argument("connected_regions: input must be CV_8U");
   const int W = cls.cols, H = cls.rows;
   std::vector<Run>& runs = ri.runs;
@@ -727,13 +726,14 @@ void connected_runs(const cv::Mat& cls, RunImage& ri, int* count, UnionFind& uf,
     }
   }
   ri.row_start[size_t(H)] = runs.size();
-  // Compact numbering in raster order of first occurrence.
-  remap.assign(runs.size(), 0);
+  // Compact numbering in raster order of first occurrence. A run's parent is an earlier run of its
+  // set (unite makes the smaller root the root, path halving points to a grandparent), so in index order
+  // a root opens the next label and any other run takes its parent's, already final.
+  const int* parent = uf.parent.data();
   int k = 0;
   for (size_t i = 0; i < runs.size(); ++i) {
-    const int root = uf.find(int(i));
-    if (remap[size_t(root)] == 0) remap[size_t(root)] = ++k;
-    runs[i].label = remap[size_t(root)];
+    const size_t p = size_t(parent[i]);
+    runs[i].label = p == i ? ++k : runs[p].label;
   }
   if (count) *count = k;
 }
@@ -778,9 +778,8 @@ cv::Mat vote_clusters(const cv::Mat& bins, int num_bins, int n) {
 cv::Mat connected_regions(const cv::Mat& cls, int* count) {
   RunImage ri;
   UnionFind uf;
-  std::vector<int> remap;
   std::vector<uint8_t> values;
-  connected_runs(cls, ri, count, uf, remap, values);
+  connected_runs(cls, ri, count, uf, values);
   cv::Mat lab;
   paint_runs(ri, cls.size(), nullptr, lab);
   return lab;
@@ -796,7 +795,6 @@ struct GodWorkspace {
   std::vector<Count> col;
   std::vector<Count8> col8;
   UnionFind cc_uf, uf;
-  std::vector<int> remap;
   std::vector<uint8_t> run_values;
   std::vector<PointSums> mom, omom;
   RunImage ri;
@@ -854,7 +852,7 @@ SegmentationResult segment_god(const cv::Mat& image, const cv::Mat& points, cons
   // only: the moments, the adjacency and the merged labels all work on the runs).
   int count = 0;
   RunImage& ri = ws.ri;
-  connected_runs(clusters, ri, &count, ws.cc_uf, ws.remap, ws.run_values);
+  connected_runs(clusters, ri, &count, ws.cc_uf, ws.run_values);
   if (debug) paint_runs(ri, clusters.size(), nullptr, init_labels);
   dbg.initial_count = count;
   const int W = image.cols, H = image.rows;
