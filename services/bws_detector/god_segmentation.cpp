@@ -799,6 +799,7 @@ struct GodWorkspace {
   std::vector<PointSums> mom, omom;
   RunImage ri;
   std::vector<uint64_t> edges, recent, edge_tmp, root_edges;
+  std::vector<uint32_t> open_runs;
   std::vector<int> edge_start;
   std::vector<Plane> planes, oplanes;
   std::vector<uint8_t> fitted;
@@ -940,16 +941,22 @@ SegmentationResult segment_god(const cv::Mat& image, const cv::Mat& points, cons
   };
   const Run* const rn = runs.data();
   const uint8_t* const cover = ri.cover.data();
+  std::vector<uint32_t>& open = ws.open_runs;  // the row's runs not covered below (listed without branches)
+  open.resize(size_t(W) + 1);
   for (int y = 0; y < H; ++y) {
     const size_t i0 = row_start[size_t(y)], i1 = row_start[size_t(y) + 1];
+    size_t num_open = 0;
+    for (size_t i = i0; i < i1; ++i) {
+      open[num_open] = uint32_t(i);
+      num_open += !(cover[i] & kCoveredBelow);
+    }
     for (size_t i = i0; i < i1; ++i)
       for (size_t k = i + 1; k < i1 && rn[k].x0 - rn[i].x1 <= R; ++k) push(rn[i].label, rn[k].label, false);
     for (int dy = 1; dy <= R && y + dy < H; ++dy) {
       size_t j = row_start[size_t(y + dy)];
       const size_t j1 = row_start[size_t(y + dy) + 1];
-      for (size_t i = i0; i < i1; ++i) {
-        if (cover[i] & kCoveredBelow) continue;
-        const Run u = rn[i];
+      for (size_t oi = 0; oi < num_open; ++oi) {
+        const Run u = rn[open[oi]];
         while (j < j1 && rn[j].x1 < u.x0 - R) ++j;  // u.x0 grows with i: j only moves forward
         for (size_t k = j; k < j1 && rn[k].x0 <= u.x1 + R; ++k) push(u.label, rn[k].label, cover[k] & kCoveredAbove);
       }
