@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <functional>
+#include <map>
 #include <memory>
 #include <optional>
 #include <random>
@@ -390,7 +391,8 @@ PlanOutcome MotionPlanner::plan(const PlanningScene& scene, const PlanRequest& r
     std::uniform_real_distribution<double> unit(0.0, 1.0);
     std::normal_distribution<double> jitter(0.0, 0.5);
     int ik_ok = 0;
-    std::string ik_reason, collision;
+    std::string ik_reason;
+    std::map<std::string, int> collisions;  // first colliding pair -> IK solutions it stopped
     Eigen::VectorXd closest;  // failed attempt that came closest: later seeds also perturb it
     std::vector<Eigen::VectorXd> near_limit_goals;  // valid, but within goal_limit_margin_rad of a joint limit
     std::vector<Eigen::VectorXd> untrackable_goals;  // valid, but the then_poses leave the joint limits from them
@@ -422,7 +424,7 @@ PlanOutcome MotionPlanner::plan(const PlanningScene& scene, const PlanRequest& r
       ++ik_ok;
       const CollisionReport c = scene.check(r.q);
       if (c.collision) {
-        if (collision.empty()) collision = c.describe();
+        ++collisions[c.describe()];
         continue;
       }
       // A goal at a joint's limit leaves the straight moves that follow it no room (the arm driver stops a
@@ -448,9 +450,16 @@ PlanOutcome MotionPlanner::plan(const PlanningScene& scene, const PlanRequest& r
     if (ik_ok == 0)
       return fail(PlanFailure::kNoIk, "no IK solution for the goal pose after " +
                                           std::to_string(params_.goal_ik_attempts) + " attempts (" + ik_reason + ")");
-    if (goals.empty())
-      return fail(PlanFailure::kGoalInCollision, "all " + std::to_string(ik_ok) +
-                                                     " IK solutions of the goal pose are in collision, e.g. " + collision);
+    if (goals.empty()) {
+      // The pairs by how many solutions they stopped, most first: where the goal pose itself is blocked.
+      std::vector<std::pair<int, std::string>> by_count;
+      for (const auto& [pair, count] : collisions) by_count.emplace_back(count, pair);
+      std::stable_sort(by_count.begin(), by_count.end(), [](const auto& a, const auto& b) { return a.first > b.first; });
+      std::string pairs;
+      for (const auto& [count, pair] : by_count) pairs += (pairs.empty() ? "" : ", ") + pair + " (" + std::to_string(count) + ")";
+      return fail(PlanFailure::kGoalInCollision,
+                  "all " + std::to_string(ik_ok) + " IK solutions of the goal pose are in collision: " + pairs);
+    }
   }
 
   out.goal_ik_time_s = elapsed();

@@ -325,7 +325,10 @@ TEST_F(MotionPlannerTest, FailureReasons) {
   pose_in.goal_pose.linear().col(1) = -Eigen::Vector3d::UnitY();
   pose_in.goal_pose.linear().col(2) = -Eigen::Vector3d::UnitZ();
   pose_in.goal_pose.translation() = Eigen::Vector3d(0.55, 0.0, 0.3);
-  EXPECT_EQ(stack_.planner.plan(*scene_, pose_in).failure, PlanFailure::kGoalInCollision);
+  r = stack_.planner.plan(*scene_, pose_in);
+  EXPECT_EQ(r.failure, PlanFailure::kGoalInCollision);
+  // The message counts the solutions each colliding pair stopped: here the pillar stops them all.
+  EXPECT_NE(r.message.find("with pillar ("), std::string::npos) << r.message;
 
   // The pillar blocks the straight line, so no planner can answer within a microsecond.
   for (const std::string name : {"CellBiRRT", "RRTConnect", "BiTRRT"}) {
