@@ -986,7 +986,8 @@ bool LibraryCycle::stripe_left_limit_passed() {
     return true;
   }
   // Books lying flat (fallen when their neighbours went) hide neither the stripe nor stand as BwS fronts: they stay.
-  message_ = where + ": no standing book right of it, and BwS sees none: no book left that the arm can take (books "
+  message_ = where +
+             ": no standing book right of it, and BwS sees none: no book left that the arm can take (books "
              "lying flat, if any, are left for the librarian)";
   progress_.finished = true;
   succeed(CycleState::kPark);

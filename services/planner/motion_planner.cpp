@@ -454,9 +454,11 @@ PlanOutcome MotionPlanner::plan(const PlanningScene& scene, const PlanRequest& r
       // The pairs by how many solutions they stopped, most first: where the goal pose itself is blocked.
       std::vector<std::pair<int, std::string>> by_count;
       for (const auto& [pair, count] : collisions) by_count.emplace_back(count, pair);
-      std::stable_sort(by_count.begin(), by_count.end(), [](const auto& a, const auto& b) { return a.first > b.first; });
+      std::stable_sort(by_count.begin(), by_count.end(),
+                       [](const auto& a, const auto& b) { return a.first > b.first; });
       std::string pairs;
-      for (const auto& [count, pair] : by_count) pairs += (pairs.empty() ? "" : ", ") + pair + " (" + std::to_string(count) + ")";
+      for (const auto& [count, pair] : by_count)
+        pairs += (pairs.empty() ? "" : ", ") + pair + " (" + std::to_string(count) + ")";
       return fail(PlanFailure::kGoalInCollision,
                   "all " + std::to_string(ik_ok) + " IK solutions of the goal pose are in collision: " + pairs);
     }
