@@ -459,15 +459,15 @@ TEST(LibraryCycle, APlaceThatAJointLimitStopsRightAboveThePoseIsDone) {
   }
   const Eigen::Vector3d place = free_world.lower[0].second.translation();
   // The driver stops the place on the lower shelf 3 mm before its pose (within limit_stop_place_m): placed;
-  // 2 cm before (beyond it, though within the stall guard): the place fails.
-  for (const double before : {0.003, 0.02}) {
+  // 2.5 cm before (beyond it, though within the stall guard): the place fails.
+  for (const double before : {0.003, 0.025}) {
     SCOPED_TRACE("stopped " + std::to_string(before) + " m before");
     FakeLibrary w(three_books());
     w.limit_near["PLACE_ON_LOWER_SHELF"] = {place, before};
     const CycleSettings s = settings();
     ASSERT_GT(s.limit_stop_place, 0.003);
-    ASSERT_LT(s.limit_stop_place, 0.02);
-    ASSERT_GT(s.geometry.lower_place_guard, 0.02);
+    ASSERT_LT(s.limit_stop_place, 0.025);
+    ASSERT_GT(s.geometry.lower_place_guard, 0.025);
     LibraryCycle cycle(s, std::nullopt);
     w.run(cycle, [&] { return cycle.progress().books_moved >= 1 || done_or_aborted(cycle); });
     if (before < s.limit_stop_place) {
