@@ -744,6 +744,7 @@ void LibraryCycle::enter(CycleState s) {
       break;
     }
     case CycleState::kMoveToHolder: {
+      // PLACE_ON_HOLDER and RETREAT_FROM_HOLDER follow.
       std::vector<Eigen::Isometry3d> then = holder_place_moves(holder_frame(), tcp_height(), g);
       then.push_back(move_along_own_axes(then.back(), Eigen::Vector3d(0, 0, -g.holder_retreat)));
       start_planned_pose(holder_pre_place_pose(holder_frame(), tcp_height(), g), true, std::move(then));
@@ -778,10 +779,11 @@ void LibraryCycle::enter(CycleState s) {
         return;
       }
       {
-        const Eigen::Isometry3d regrasp = holder_place_pose(holder_frame(), holder_regrasp_height(tcp_height(), g), g);
+        // APPROACH_HOLDER and LIFT_FROM_HOLDER follow.
+        const double h = holder_regrasp_height(tcp_height(), g);
+        const Eigen::Isometry3d regrasp = holder_place_pose(holder_frame(), h, g);
         std::vector<Eigen::Isometry3d> then{regrasp};
-        for (const Eigen::Isometry3d& p : holder_lift_moves(holder_frame(), holder_regrasp_height(tcp_height(), g), g))
-          then.push_back(p);
+        for (const Eigen::Isometry3d& p : holder_lift_moves(holder_frame(), h, g)) then.push_back(p);
         start_planned_pose(move_along_own_axes(regrasp, Eigen::Vector3d(0, 0, -g.holder_retreat)), false,
                            std::move(then));
         break;
@@ -797,10 +799,12 @@ void LibraryCycle::enter(CycleState s) {
               " (it stays in the gripper)");
         return;
       }
-      const Eigen::Isometry3d place = lower_place_pose(cart_frame(), progress_.lower_next_right_y, progress_.book_width,
-                                                       height_held_from_holder(tcp_height(), g), g);
-      start_planned_pose(lower_pre_place_pose(cart_frame(), progress_.lower_next_right_y, progress_.book_width,
-                                              height_held_from_holder(tcp_height(), g), held_box_height(), g),
+      // PLACE_ON_LOWER_SHELF and RETREAT_FROM_LOWER_SHELF follow.
+      const double held = height_held_from_holder(tcp_height(), g);
+      const Eigen::Isometry3d place =
+          lower_place_pose(cart_frame(), progress_.lower_next_right_y, progress_.book_width, held, g);
+      start_planned_pose(lower_pre_place_pose(cart_frame(), progress_.lower_next_right_y, progress_.book_width, held,
+                                              held_box_height(), g),
                          true, {place, move_along_own_axes(place, Eigen::Vector3d(0, 0, -g.lower_retreat))});
       break;
     }
