@@ -182,29 +182,24 @@ bool straight_moves_trackable(const InverseKinematics& ik, const Eigen::VectorXd
     const double length = (b.translation() - a.translation()).norm();
     const int steps = std::max(1, static_cast<int>(std::ceil(std::max(length / params.then_step_m,
                                                                       ra.angularDistance(rb) / params.then_step_rad))));
-    const std::string move =
-        "straight move " + std::to_string(m + 1) + " of " + std::to_string(then.size()) + " (" + fmt(length) + " m)";
     for (int k = 1; k <= steps; ++k) {
       const double t = static_cast<double>(k) / steps;
       Eigen::Isometry3d target = Eigen::Isometry3d::Identity();
       target.linear() = ra.slerp(t, rb).toRotationMatrix();
       target.translation() = a.translation() + t * (b.translation() - a.translation());
       const IkResult r = ik.solve_once(target, at, ik.params().max_iterations, 0);
-      const std::string where = move + " at " + fmt(100.0 * t) + " %";
-      if (!r.success) {
-        *why = where + ": no IK (" + r.reason + ")";
+      // Says where tracking stopped (built only then: this loop runs ~100 IK steps per goal solution).
+      const auto stop = [&](const std::string& what) {
+        *why = "straight move " + std::to_string(m + 1) + " of " + std::to_string(then.size()) + " (" +
+               fmt(length) + " m) at " + fmt(100.0 * t) + " %: " + what;
         return false;
-      }
+      };
+      if (!r.success) return stop("no IK (" + r.reason + ")");
       for (int j = 0; j < r.q.size(); ++j)
         if (r.q[j] < kin.lower_limits()[j] + params.then_limit_margin_rad ||
-            r.q[j] > kin.upper_limits()[j] - params.then_limit_margin_rad) {
-          *why = where + ": " + kin.joint_names()[j] + " at its limit";
-          return false;
-        }
-      if ((r.q - at).cwiseAbs().maxCoeff() > kMaxJointStepRad) {
-        *why = where + ": the posture jumps (another IK branch)";
-        return false;
-      }
+            r.q[j] > kin.upper_limits()[j] - params.then_limit_margin_rad)
+          return stop(kin.joint_names()[j] + " at its limit");
+      if ((r.q - at).cwiseAbs().maxCoeff() > kMaxJointStepRad) return stop("the posture jumps (another IK branch)");
       at = r.q;
     }
     a = b;
@@ -313,12 +308,17 @@ PlanOutcome MotionPlanner::plan(const PlanningScene& scene, const PlanRequest& r
   const auto tilt_of = [](const Eigen::Matrix3d& r) { return std::acos(std::clamp(r(2, 0), -1.0, 1.0)); };
   // Pitch of the tool's z axis from the horizontal plane (sine = the magnitude of its z component).
   const auto pitch_of = [](const Eigen::Matrix3d& r) { return std::asin(std::clamp(std::abs(r(2, 2)), 0.0, 1.0)); };
-  const StateCheck valid = [&scene, &kin, keep, kept, band, min_up, max_pitch_sin](const Eigen::VectorXd& q) {
+  // The path's tool bounds: the x axis within max_tool_tilt_rad of upright, the z axis within max_tool_pitch_rad of
+  // horizontal.
+  const auto within_tool_bounds = [min_up, max_pitch_sin](const Eigen::Matrix3d& r) {
+    return !(r(2, 0) < min_up) && !(std::abs(r(2, 2)) > max_pitch_sin);
+  };
+  const StateCheck valid = [&scene, &kin, keep, kept, band, min_up, max_pitch_sin,
+                            within_tool_bounds](const Eigen::VectorXd& q) {
     if (keep || min_up > -1.5 || max_pitch_sin < 1.5) {
       const Eigen::Matrix3d r = kin.tip_pose(q).linear();
       if (keep && rotation_angle(r, kept) > band) return false;
-      if (r(2, 0) < min_up) return false;
-      if (std::abs(r(2, 2)) > max_pitch_sin) return false;
+      if (!within_tool_bounds(r)) return false;
     }
     return scene.is_valid(q);
   };
@@ -358,9 +358,8 @@ PlanOutcome MotionPlanner::plan(const PlanningScene& scene, const PlanRequest& r
     const CollisionReport touching = scene.check(start, false);
     if (touching.collision)
       return fail(PlanFailure::kStartInCollision, "start is in collision: " + touching.describe() + " (touching)");
-    const StateCheck exact_ok = [&scene, min_up, max_pitch_sin, &kin](const Eigen::VectorXd& q) {
-      const Eigen::Matrix3d r = kin.tip_pose(q).linear();
-      return r(2, 0) >= min_up && std::abs(r(2, 2)) <= max_pitch_sin && !scene.check(q, false).collision;
+    const StateCheck exact_ok = [&scene, &kin, within_tool_bounds](const Eigen::VectorXd& q) {
+      return within_tool_bounds(kin.tip_pose(q).linear()) && !scene.check(q, false).collision;
     };
     const std::optional<Eigen::VectorXd> escape = find_start_escape(start, valid, exact_ok, kin, params_, req.seed);
     if (!escape)
