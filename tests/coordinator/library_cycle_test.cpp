@@ -351,7 +351,11 @@ TEST(LibraryCycle, BadDepthKeysNameTheKey) {
   const std::string shipped = ss.str();
   for (const auto& [key, line, bad] : {std::tuple<std::string, std::string, std::string>{
                                            "grasp.deep_front_z_m", "deep_front_z_m: 0.035", "deep_front_z_m: 0.9"},
-                                       {"servo.book_front_z_m", "book_front_z_m: 0.01", "book_front_z_m: 0.5"}}) {
+                                       {"servo.book_front_z_m", "book_front_z_m: 0.01", "book_front_z_m: 0.5"},
+                                       // Right of position A (Y 0.30): the servo would stop before it starts.
+                                       {"servo.stripe_left_limit_y_m", "stripe_left_limit_y_m: -0.15",
+                                        "stripe_left_limit_y_m: 0.35"},
+                                       {"limit_stop_place_m", "limit_stop_place_m: 0.02", "limit_stop_place_m: 0.2"}}) {
     std::string text = shipped;
     const auto pos = text.find(line);
     ASSERT_NE(pos, std::string::npos) << line;
