@@ -39,7 +39,8 @@ double percentile(std::vector<double> v, double p) {
 
 struct Stats {
   int runs = 0, ok = 0, violations = 0;
-  std::vector<double> ms, length, ik_ms, search_ms, simplify_ms;
+  std::vector<double> ms, length, ik_ms, search_ms, simplify_ms, steps;
+  double total_search_ms = 0.0, total_steps = 0.0;  // search steps per ms of search: calibrates max_search_steps
   std::map<std::string, int> failures;
   std::map<std::string, std::pair<int, int>> by_kind;  // ok, runs
 };
@@ -115,6 +116,9 @@ int main(int argc, char** argv) {
         s.ik_ms.push_back(1000.0 * r.goal_ik_time_s);
         s.search_ms.push_back(1000.0 * r.search_time_s);
         s.simplify_ms.push_back(1000.0 * r.simplify_time_s);
+        s.steps.push_back(static_cast<double>(r.search_steps));
+        s.total_search_ms += 1000.0 * r.search_time_s;
+        s.total_steps += static_cast<double>(r.search_steps);
         if (r.success) {
           ++s.ok;
           ++s.by_kind[q.kind].first;
@@ -156,6 +160,9 @@ int main(int argc, char** argv) {
       js << "    \"path_length\": {\"median\": " << percentile(s.length, 0.5) << "},\n";
       js << "    \"parts_ms_median\": {\"goal_ik\": " << percentile(s.ik_ms, 0.5) << ", \"search\": "
          << percentile(s.search_ms, 0.5) << ", \"simplify\": " << percentile(s.simplify_ms, 0.5) << "},\n";
+      js << "    \"search_steps\": {\"median\": " << percentile(s.steps, 0.5) << ", \"p95\": " << percentile(s.steps, 0.95)
+         << ", \"max\": " << percentile(s.steps, 1.0) << ", \"per_search_ms\": "
+         << (s.total_search_ms > 0 ? s.total_steps / s.total_search_ms : 0.0) << "},\n";
       js << "    \"runs\": " << s.runs << ",\n    \"failures\": {";
       bool first = true;
       for (const auto& [k, v] : s.failures) {
@@ -182,6 +189,9 @@ int main(int argc, char** argv) {
                 << std::setprecision(2) << percentile(s.length, 0.5) << " rad";
       std::cout << "  [median ms: goal IK " << std::setprecision(1) << percentile(s.ik_ms, 0.5) << ", search "
                 << percentile(s.search_ms, 0.5) << ", simplify " << percentile(s.simplify_ms, 0.5) << "]";
+      std::cout << "  search steps median " << std::setprecision(0) << percentile(s.steps, 0.5) << " max "
+                << percentile(s.steps, 1.0) << " (" << std::setprecision(1)
+                << (s.total_search_ms > 0 ? s.total_steps / s.total_search_ms : 0.0) << " per search ms)";
       if (verify) std::cout << "  dense violations " << s.violations;
       std::cout << "\n";
     }

@@ -550,15 +550,24 @@ PlanOutcome MotionPlanner::plan(const PlanningScene& scene, const PlanRequest& r
   planner->setProblemDefinition(pdef);
   planner->setup();
   const double search_begin = elapsed();
-  const ob::PlannerStatus status = planner->solve(ob::timedPlannerTerminationCondition(req.time_budget_s));
+  // The step count decides (load-independent, so a composed run gives the same answer on a busy machine); the
+  // clock is the safety stop.
+  auto steps = std::make_shared<long>(0);
+  const long max_steps = params_.max_search_steps;
+  const ob::PlannerTerminationCondition step_limit([steps, max_steps] { return ++*steps > max_steps && max_steps > 0; });
+  const ob::PlannerStatus status = planner->solve(
+      ob::plannerOrTerminationCondition(step_limit, ob::timedPlannerTerminationCondition(req.time_budget_s)));
   out.search_time_s = elapsed() - search_begin;
+  out.search_steps = std::min(*steps, max_steps > 0 ? max_steps : *steps);
   if (status != ob::PlannerStatus::EXACT_SOLUTION || !pdef->hasExactSolution()) {
     std::string detail = "status: " + status.asString();
     if (cell)
       detail += ", " + std::to_string(cell->tree_size()) + " nodes, cell samples " +
                 std::to_string(cell->cell_samples_ok()) + "/" + std::to_string(cell->cell_samples_tried());
-    return fail(PlanFailure::kTimeout, out.planner + " found no path within the time budget of " +
-                                           fmt(req.time_budget_s) + " s (" + detail + ")");
+    const std::string limit = max_steps > 0 && *steps > max_steps
+                                  ? std::to_string(max_steps) + " search steps (planner.max_search_steps)"
+                                  : "the time budget of " + fmt(req.time_budget_s) + " s";
+    return fail(PlanFailure::kTimeout, out.planner + " found no path within " + limit + " (" + detail + ")");
   }
   const auto* path = pdef->getSolutionPath()->as<og::PathGeometric>();
   for (size_t i = 0; i < path->getStateCount(); ++i) out.raw_path.push_back(from_state(path->getState(i), n));

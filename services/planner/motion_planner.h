@@ -51,7 +51,7 @@ struct PlanRequest {
   /// Pose goal: the straight (Cartesian) moves the arm makes after it, in order (tool poses in base). Goal IK
   /// solutions from which tracking them leaves the joint limits are used only when there is no other.
   std::vector<Eigen::Isometry3d> then_poses;
-  double time_budget_s = 1.0;             ///< planning time limit (wall clock)
+  double time_budget_s = 1.0;             ///< planning time limit (wall clock; see MotionPlannerParams::max_search_steps)
   std::string planner;                    ///< "CellBiRRT", "RRTConnect", "BiTRRT"; "" = default
   uint64_t seed = 1;                      ///< random seed (same request + seed -> same path)
 };
@@ -69,6 +69,7 @@ struct PlanOutcome {
   double goal_ik_time_s = 0.0;         ///< part of planning_time_s spent on goal IK
   double search_time_s = 0.0;          ///< part spent in the planner's search
   double simplify_time_s = 0.0;        ///< part spent simplifying and timing the path
+  long search_steps = 0;               ///< termination checks the search made (MotionPlannerParams::max_search_steps)
   double path_length_rad = 0.0;        ///< joint-space length of `path`
 };
 
@@ -77,6 +78,10 @@ struct MotionPlannerParams {
   std::string default_planner = "CellBiRRT";
   double collision_resolution_rad = 0.01;  ///< motion checks every this many rad (joint-space norm)
   double range_rad = 0.3;                  ///< tree extension step of all planners
+  /// > 0: the search stops after this many evaluations of its termination condition (about one per tree
+  /// extension), whatever the clock says, so the outcome does not depend on the machine's load; the request's
+  /// time budget still applies as a safety stop. 0: the time budget alone decides.
+  int max_search_steps = 0;
   int simplify_shortcuts = 60;             ///< random shortcut attempts
   int goal_ik_solutions = 4;               ///< distinct valid IK solutions used as goals for a pose goal
   int goal_ik_attempts = 24;               ///< IK attempts to find them

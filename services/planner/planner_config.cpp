@@ -85,6 +85,7 @@ PlannerSettings PlannerSettings::from_config(const Config& root) {
   s.max_time_budget_s = pl.get_double("max_time_budget_s", 1e-3, 600.0);
   p.collision_resolution_rad = pl.get_double("collision_resolution_rad", 1e-4, 0.5);
   p.range_rad = pl.get_double("range_rad", 1e-3, 10.0);
+  p.max_search_steps = pl.get_int("max_search_steps", 0, 100000000);
   p.simplify_shortcuts = pl.get_int("simplify_shortcuts", 0, 100000);
   p.goal_ik_solutions = pl.get_int("goal_ik_solutions", 1, 100);
   p.goal_ik_attempts = pl.get_int("goal_ik_attempts", 1, 10000);

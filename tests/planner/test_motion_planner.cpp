@@ -343,6 +343,39 @@ TEST_F(MotionPlannerTest, FailureReasons) {
   EXPECT_EQ(stack_.planner.plan(*scene_, budget).failure, PlanFailure::kInvalidRequest);
 }
 
+TEST_F(MotionPlannerTest, TheSearchStepLimitDecidesNotTheClock) {
+  // The pillar blocks the straight line: no planner finds a path in 3 search steps, however long the clock allows,
+  // and the message names the limit (a composed run on a busy machine must get the answer a quiet one gets).
+  MotionPlannerParams few = stack_.planner.params();
+  few.max_search_steps = 3;
+  const MotionPlanner stepped(stack_.planner.ik(), few);
+  PlanRequest req;
+  req.start = start_;
+  req.goal_joints = goal_;
+  req.time_budget_s = 60.0;
+  req.seed = 5;
+  for (const std::string name : {"CellBiRRT", "RRTConnect", "BiTRRT"}) {
+    req.planner = name;
+    const PlanOutcome r = stepped.plan(*scene_, req);
+    EXPECT_EQ(r.failure, PlanFailure::kTimeout) << name << ": " << r.message;
+    EXPECT_NE(r.message.find("within 3 search steps (planner.max_search_steps)"), std::string::npos) << r.message;
+    EXPECT_EQ(r.search_steps, 3) << name;
+  }
+  // With room to search, the same request succeeds within the limit, and twice the same way.
+  MotionPlannerParams many = few;
+  many.max_search_steps = 200000;
+  const MotionPlanner roomy(stack_.planner.ik(), many);
+  req.planner = "CellBiRRT";
+  const PlanOutcome a = roomy.plan(*scene_, req);
+  const PlanOutcome b = roomy.plan(*scene_, req);
+  expect_collision_free(*scene_, a);
+  EXPECT_GT(a.search_steps, 3);
+  EXPECT_LE(a.search_steps, 200000);
+  EXPECT_EQ(a.search_steps, b.search_steps);
+  ASSERT_EQ(a.path.size(), b.path.size());
+  for (size_t i = 0; i < a.path.size(); ++i) EXPECT_TRUE(a.path[i].isApprox(b.path[i], 0.0)) << "waypoint " << i;
+}
+
 TEST_F(MotionPlannerTest, AStartWithinTheMarginIsLeftStraightFirst) {
   // The arm stopped closer to the pillar than the environment margin but touching nothing (a servo that ended near
   // the holder's back plate): the first state along start_ -> "arm through the pillar" that breaks the margin.
