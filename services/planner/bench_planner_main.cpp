@@ -160,9 +160,9 @@ int main(int argc, char** argv) {
       js << "    \"path_length\": {\"median\": " << percentile(s.length, 0.5) << "},\n";
       js << "    \"parts_ms_median\": {\"goal_ik\": " << percentile(s.ik_ms, 0.5) << ", \"search\": "
          << percentile(s.search_ms, 0.5) << ", \"simplify\": " << percentile(s.simplify_ms, 0.5) << "},\n";
-      js << "    \"search_steps\": {\"median\": " << percentile(s.steps, 0.5) << ", \"p95\": " << percentile(s.steps, 0.95)
-         << ", \"max\": " << percentile(s.steps, 1.0) << ", \"per_search_ms\": "
-         << (s.total_search_ms > 0 ? s.total_steps / s.total_search_ms : 0.0) << "},\n";
+      js << "    \"search_steps\": {\"median\": " << percentile(s.steps, 0.5)
+         << ", \"p95\": " << percentile(s.steps, 0.95) << ", \"max\": " << percentile(s.steps, 1.0)
+         << ", \"per_search_ms\": " << (s.total_search_ms > 0 ? s.total_steps / s.total_search_ms : 0.0) << "},\n";
       js << "    \"runs\": " << s.runs << ",\n    \"failures\": {";
       bool first = true;
       for (const auto& [k, v] : s.failures) {

@@ -554,7 +554,8 @@ PlanOutcome MotionPlanner::plan(const PlanningScene& scene, const PlanRequest& r
   // clock is the safety stop.
   auto steps = std::make_shared<long>(0);
   const long max_steps = params_.max_search_steps;
-  const ob::PlannerTerminationCondition step_limit([steps, max_steps] { return ++*steps > max_steps && max_steps > 0; });
+  const ob::PlannerTerminationCondition step_limit(
+      [steps, max_steps] { return ++*steps > max_steps && max_steps > 0; });
   const ob::PlannerStatus status = planner->solve(
       ob::plannerOrTerminationCondition(step_limit, ob::timedPlannerTerminationCondition(req.time_budget_s)));
   out.search_time_s = elapsed() - search_begin;

@@ -51,7 +51,7 @@ struct PlanRequest {
   /// Pose goal: the straight (Cartesian) moves the arm makes after it, in order (tool poses in base). Goal IK
   /// solutions from which tracking them leaves the joint limits are used only when there is no other.
   std::vector<Eigen::Isometry3d> then_poses;
-  double time_budget_s = 1.0;             ///< planning time limit (wall clock; see MotionPlannerParams::max_search_steps)
+  double time_budget_s = 1.0;  ///< planning time limit (wall clock; see MotionPlannerParams::max_search_steps)
   std::string planner;                    ///< "CellBiRRT", "RRTConnect", "BiTRRT"; "" = default
   uint64_t seed = 1;                      ///< random seed (same request + seed -> same path)
 };
