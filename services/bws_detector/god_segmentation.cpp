@@ -17,6 +17,13 @@
 #if defined(__SSE2__)
 #include <emmintrin.h>
 #endif
+#if defined(__SSE2__) && defined(__GNUC__)
+// The voting and the bins also have AVX2 forms, compiled for that instruction set with the `target`
+// attribute and chosen at run time (`has_avx2`): the build itself targets baseline x86-64.
+#include <immintrin.h>
+#define BOOKGRASP_GOD_AVX2 1
+#define GOD_TARGET_AVX2 __attribute__((target("avx2")))
+#endif
 
 namespace bookgrasp::bws {
 
@@ -269,6 +276,67 @@ void sort_candidates(std::vector<Candidate>& c, std::vector<Candidate>& tmp, std
   }
 }
 
+#if defined(BOOKGRASP_GOD_AVX2)
+/// True when the CPU runs AVX2 (checked once).
+bool has_avx2() {
+  static const bool avx2 = __builtin_cpu_supports("avx2");
+  return avx2;
+}
+
+/// valid_value of eight floats as a lane mask (0 < v < inf).
+GOD_TARGET_AVX2 inline __m256 valid8(__m256 v, __m256 zero, __m256 inf) {
+  return _mm256_and_ps(_mm256_cmp_ps(v, zero, _CMP_GT_OQ), _mm256_cmp_ps(v, inf, _CMP_LT_OQ));
+}
+
+/// god_bins_of_image's four-pixel SSE2 step on eight pixels (AVX, the same single-precision operations
+/// per lane; the AVX2 target has no fused multiply-add, so the same bits) for the columns x, x + 8, ...
+/// of one row while x + 8 <= x_end. Returns the first column not done.
+GOD_TARGET_AVX2 int god_bins_row_avx2(const float* up, const float* mid, const float* dn, uint8_t* b, int x, int x_end,
+                                      int s, float flat, float jump, float w, int B) {
+  const __m256 zero = _mm256_setzero_ps(), inf = _mm256_set1_ps(std::numeric_limits<float>::infinity());
+  const __m256 vflat = _mm256_set1_ps(flat), vjump = _mm256_set1_ps(jump), vw = _mm256_set1_ps(w);
+  const __m256 sign = _mm256_set1_ps(-0.f), half = _mm256_set1_ps(0.5f);
+  const __m256i vB = _mm256_set1_epi32(B), vBm1 = _mm256_set1_epi32(B - 1), v255 = _mm256_set1_epi32(255);
+  for (; x + 8 <= x_end; x += 8) {
+    const __m256 c = _mm256_loadu_ps(mid + x), r = _mm256_loadu_ps(mid + x + s), l = _mm256_loadu_ps(mid + x - s);
+    const __m256 d = _mm256_loadu_ps(dn + x), u = _mm256_loadu_ps(up + x);
+    const __m256 ok = _mm256_and_ps(_mm256_and_ps(_mm256_and_ps(valid8(c, zero, inf), valid8(r, zero, inf)),
+                                                  _mm256_and_ps(valid8(l, zero, inf), valid8(d, zero, inf))),
+                                    valid8(u, zero, inf));
+    const __m256 dx = _mm256_sub_ps(r, l), dy = _mm256_sub_ps(d, u);
+    const __m256 m = _mm256_sqrt_ps(_mm256_add_ps(_mm256_mul_ps(dx, dx), _mm256_mul_ps(dy, dy)));
+    const __m256 votes = _mm256_and_ps(ok, _mm256_cmp_ps(m, vjump, _CMP_LE_OQ));
+    if (_mm256_movemask_ps(votes) == 0) continue;  // the row was set to 255
+    const __m256 is_flat = _mm256_cmp_ps(m, vflat, _CMP_LE_OQ);
+    // direction_deg
+    const __m256 ax = _mm256_andnot_ps(sign, dx), ay = _mm256_andnot_ps(sign, dy);
+    const __m256 t = _mm256_div_ps(_mm256_min_ps(ay, ax), _mm256_max_ps(ay, ax));  // min(ax, ay) / max(ax, ay)
+    const __m256 s2 = _mm256_mul_ps(t, t);
+    __m256 p = _mm256_mul_ps(s2, _mm256_set1_ps(0.0208351f));
+    p = _mm256_mul_ps(s2, _mm256_add_ps(_mm256_set1_ps(-0.0851330f), p));
+    p = _mm256_mul_ps(s2, _mm256_add_ps(_mm256_set1_ps(0.1801410f), p));
+    p = _mm256_mul_ps(s2, _mm256_add_ps(_mm256_set1_ps(-0.3302995f), p));
+    __m256 a = _mm256_mul_ps(t, _mm256_add_ps(_mm256_set1_ps(0.9998660f), p));
+    a = _mm256_mul_ps(a, _mm256_set1_ps(57.295779513f));
+    a = _mm256_blendv_ps(a, _mm256_sub_ps(_mm256_set1_ps(90.f), a), _mm256_cmp_ps(ay, ax, _CMP_GT_OQ));
+    a = _mm256_blendv_ps(a, _mm256_sub_ps(_mm256_set1_ps(180.f), a), _mm256_cmp_ps(dx, zero, _CMP_LT_OQ));
+    a = _mm256_blendv_ps(a, _mm256_xor_ps(a, sign), _mm256_cmp_ps(dy, zero, _CMP_LT_OQ));
+    a = _mm256_blendv_ps(a, _mm256_add_ps(a, _mm256_set1_ps(360.f)), _mm256_cmp_ps(a, zero, _CMP_LE_OQ));
+    __m256i k = _mm256_cvttps_epi32(_mm256_add_ps(_mm256_div_ps(a, vw), half));
+    k = _mm256_sub_epi32(k, _mm256_and_si256(_mm256_cmpgt_epi32(k, vBm1), vB));  // k >= B: k -= B
+    k = _mm256_blendv_epi8(k, vB, _mm256_castps_si256(is_flat));
+    k = _mm256_blendv_epi8(v255, k, _mm256_castps_si256(votes));
+    // Bytes: the packs work within each 128-bit half, so pixels 0-3 and 4-7 end in the halves' low words.
+    k = _mm256_packus_epi16(_mm256_packs_epi32(k, k), _mm256_packs_epi32(k, k));
+    const int32_t lo = _mm_cvtsi128_si32(_mm256_castsi256_si128(k)),
+                  hi = _mm_cvtsi128_si32(_mm256_extracti128_si256(k, 1));
+    std::memcpy(b + x, &lo, 4);
+    std::memcpy(b + x + 4, &hi, 4);
+  }
+  return x;
+}
+#endif
+
 /// god_bins(compute_god_features(image, s, flat), B, jump) without the two float images (same arithmetic,
 /// and no arctangent for jump pixels, which do not vote).
 void god_bins_of_image(const cv::Mat& image, int s, double flat_mgod_max, int B, double jump_mgod_min, cv::Mat& bins) {
@@ -281,6 +349,9 @@ void god_bins_of_image(const cv::Mat& image, int s, double flat_mgod_max, int B,
     const float* dn = image.ptr<float>(y + s);
     uint8_t* b = bins.ptr<uint8_t>(y);
     int x = s;
+#if defined(BOOKGRASP_GOD_AVX2)
+    if (has_avx2()) x = god_bins_row_avx2(up, mid, dn, b, x, image.cols - s, s, flat, jump, w, B);
+#endif
 #if defined(__SSE2__)
     // Four pixels at a time, the scalar loop's operations in the same order (IEEE single precision
     // either way, no fused multiply-add on this target), branches as masks.
@@ -504,6 +575,8 @@ void vote_clusters_planar_r(const cv::Mat& bins, int num_bins, cv::Mat& out, std
     const uint8_t* bo = out_row >= 0 ? bins.ptr<uint8_t>(out_row) : nullptr;
     for (int x = 0; x < W; x += 16) {
       const __m128i vi = bi ? load_bins(bi, x) : none, vo = bo ? load_bins(bo, x) : none;
+      // No pixel of either row votes here (all 255, e.g. no disparity): no column histogram changes.
+      if (_mm_movemask_epi8(_mm_cmpeq_epi8(_mm_and_si128(vi, vo), none)) == 0xffff) continue;
       __m128i kk = _mm_setzero_si128();
       for (int k = 0; k < num_bins; ++k, kk = _mm_sub_epi8(kk, none)) {  // kk: k in every lane
         __m128i* c = reinterpret_cast<__m128i*>(planes + size_t(k) * stride + size_t(x + r));
@@ -513,6 +586,16 @@ void vote_clusters_planar_r(const cv::Mat& bins, int num_bins, cv::Mat& out, std
       }
     }
   };
+  // Stores 16 results at column x of row o (only the row's pixels).
+  const auto store_out = [&](uint8_t* o, int x, __m128i res) {
+    if (x + 16 <= W) {
+      _mm_storeu_si128(reinterpret_cast<__m128i*>(o + x), res);
+    } else {
+      alignas(16) uint8_t tmp[16];
+      _mm_store_si128(reinterpret_cast<__m128i*>(tmp), res);
+      std::copy(tmp, tmp + (W - x), o + x);
+    }
+  };
   for (int y = 0; y <= std::min(r, H - 1); ++y) col_update(y, -1);
   out.create(bins.size(), CV_8U);
   for (int y = 0; y < H; ++y) {
@@ -520,6 +603,13 @@ void vote_clusters_planar_r(const cv::Mat& bins, int num_bins, cv::Mat& out, std
     const uint8_t* b = bins.ptr<uint8_t>(y);
     uint8_t* o = out.ptr<uint8_t>(y);
     for (int x = 0; x < W; x += 16) {
+      const __m128i vb = load_bins(b, x);
+      // Voting pixels have a bin < num_bins (<= 255): bins are unsigned, compared after flipping the sign bit.
+      const __m128i votes = _mm_cmplt_epi8(_mm_xor_si128(vb, bias), _mm_xor_si128(_mm_set1_epi8(char(num_bins)), bias));
+      if (_mm_movemask_epi8(votes) == 0) {  // none of the 16 pixels votes: all stay 255, no window counts needed
+        store_out(o, x, none);
+        continue;
+      }
       // Window count of bin k for pixels x..x+15: columns x - r .. x + 15 + r (plane offsets x .. x + 2r).
       const auto window = [&](int k) {
         const uint8_t* c = planes + size_t(k) * stride + size_t(x);
@@ -536,23 +626,121 @@ void vote_clusters_planar_r(const cv::Mat& bins, int num_bins, cv::Mat& out, std
         best = _mm_or_si128(_mm_and_si128(gt, sb), _mm_andnot_si128(gt, best));
         arg = _mm_or_si128(_mm_and_si128(gt, kk), _mm_andnot_si128(gt, arg));
       }
-      const __m128i vb = load_bins(b, x);
-      // Voting pixels have a bin < num_bins (<= 255): bins are unsigned, compared after flipping the sign bit.
-      const __m128i votes = _mm_cmplt_epi8(_mm_xor_si128(vb, bias), _mm_xor_si128(_mm_set1_epi8(char(num_bins)), bias));
-      const __m128i res = _mm_or_si128(_mm_and_si128(votes, arg), _mm_andnot_si128(votes, none));
-      if (x + 16 <= W) {
-        _mm_storeu_si128(reinterpret_cast<__m128i*>(o + x), res);
-      } else {
-        alignas(16) uint8_t tmp[16];
-        _mm_store_si128(reinterpret_cast<__m128i*>(tmp), res);
-        std::copy(tmp, tmp + (W - x), o + x);
-      }
+      store_out(o, x, _mm_or_si128(_mm_and_si128(votes, arg), _mm_andnot_si128(votes, none)));
     }
   }
 }
 
+#if defined(BOOKGRASP_GOD_AVX2)
+/// 32 bins of a row from column x (255 past the row's W pixels).
+GOD_TARGET_AVX2 inline __m256i load_bins32(const uint8_t* b, int x, int W) {
+  if (x + 32 <= W) return _mm256_loadu_si256(reinterpret_cast<const __m256i*>(b + x));
+  alignas(32) uint8_t tmp[32];
+  std::fill(tmp, tmp + 32, uint8_t(255));
+  std::copy(b + x, b + W, tmp);
+  return _mm256_load_si256(reinterpret_cast<const __m256i*>(tmp));
+}
+
+/// Stores the 32 results `res` at column x of the row `o` (only the row's W pixels).
+GOD_TARGET_AVX2 inline void store_out32(uint8_t* o, int x, int W, __m256i res) {
+  if (x + 32 <= W) {
+    _mm256_storeu_si256(reinterpret_cast<__m256i*>(o + x), res);
+    return;
+  }
+  alignas(32) uint8_t tmp[32];
+  _mm256_store_si256(reinterpret_cast<__m256i*>(tmp), res);
+  std::copy(tmp, tmp + (W - x), o + x);
+}
+
+/// vote_clusters_planar_r's column update on 32 lanes: the column histograms (planes of `stride` bytes,
+/// column x at x + r) += the bins of row `in`, -= those of row `out_row` (either may be null: none).
+GOD_TARGET_AVX2 inline void col_update32(uint8_t* planes, size_t stride, int r, int num_bins, int W, const uint8_t* in,
+                                         const uint8_t* out_row) {
+  const __m256i none = _mm256_set1_epi8(char(-1));
+  for (int x = 0; x < W; x += 32) {
+    const __m256i vi = in ? load_bins32(in, x, W) : none, vo = out_row ? load_bins32(out_row, x, W) : none;
+    if (_mm256_movemask_epi8(_mm256_cmpeq_epi8(_mm256_and_si256(vi, vo), none)) == -1) continue;
+    __m256i kk = _mm256_setzero_si256();
+    for (int k = 0; k < num_bins; ++k, kk = _mm256_sub_epi8(kk, none)) {  // kk: k in every lane
+      __m256i* c = reinterpret_cast<__m256i*>(planes + size_t(k) * stride + size_t(x + r));
+      const __m256i v = _mm256_sub_epi8(_mm256_loadu_si256(c), _mm256_cmpeq_epi8(vi, kk));
+      _mm256_storeu_si256(c, _mm256_add_epi8(v, _mm256_cmpeq_epi8(vo, kk)));
+    }
+  }
+}
+
+/// vote_clusters_planar_r on 32 pixels at a time (AVX2): the same byte operations on twice the lanes,
+/// so the same clusters. The planes get a wider padding (32-byte loads up to column W - 1 + 2r + 31).
+template <int kR>
+GOD_TARGET_AVX2 void vote_clusters_planar_avx2_r(const cv::Mat& bins, int num_bins, cv::Mat& out,
+                                                 std::vector<uint8_t>& colp) {
+  constexpr int r = kR;
+  const int W = bins.cols, H = bins.rows;
+  const size_t stride = size_t(W + 2 * r + 64) & ~size_t(31);
+  colp.assign(size_t(num_bins) * stride, 0);
+  uint8_t* const planes = colp.data();
+  const __m256i bias = _mm256_set1_epi8(char(-128)), none = _mm256_set1_epi8(char(-1));
+  const __m256i limit = _mm256_xor_si256(_mm256_set1_epi8(char(num_bins)), bias);
+  for (int y = 0; y <= std::min(r, H - 1); ++y)
+    col_update32(planes, stride, r, num_bins, W, bins.ptr<uint8_t>(y), nullptr);
+  out.create(bins.size(), CV_8U);
+  for (int y = 0; y < H; ++y) {
+    if (y > 0)
+      col_update32(planes, stride, r, num_bins, W, y + r < H ? bins.ptr<uint8_t>(y + r) : nullptr,
+                   y - r - 1 >= 0 ? bins.ptr<uint8_t>(y - r - 1) : nullptr);
+    const uint8_t* b = bins.ptr<uint8_t>(y);
+    uint8_t* o = out.ptr<uint8_t>(y);
+    for (int x = 0; x < W; x += 32) {
+      const __m256i votes = _mm256_cmpgt_epi8(limit, _mm256_xor_si256(load_bins32(b, x, W), bias));
+      if (_mm256_movemask_epi8(votes) == 0) {
+        store_out32(o, x, W, none);
+        continue;
+      }
+      __m256i best = _mm256_setzero_si256(), arg = _mm256_setzero_si256(), kk = _mm256_setzero_si256();
+      for (int k = 0; k < num_bins; ++k, kk = _mm256_sub_epi8(kk, none)) {
+        const uint8_t* c = planes + size_t(k) * stride + size_t(x);
+        __m256i sum = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(c));
+        for (int j = 1; j <= 2 * r; ++j)
+          sum = _mm256_add_epi8(sum, _mm256_loadu_si256(reinterpret_cast<const __m256i*>(c + j)));
+        sum = _mm256_xor_si256(sum, bias);
+        if (k == 0) {
+          best = sum;
+          continue;
+        }
+        const __m256i gt = _mm256_cmpgt_epi8(sum, best);
+        best = _mm256_blendv_epi8(best, sum, gt);
+        arg = _mm256_blendv_epi8(arg, kk, gt);
+      }
+      store_out32(o, x, W, _mm256_blendv_epi8(none, arg, votes));
+    }
+  }
+}
+#endif
+
 /// vote_clusters_planar_r for the window's half size r (0..7).
 void vote_clusters_planar(const cv::Mat& bins, int num_bins, int r, cv::Mat& out, std::vector<uint8_t>& colp) {
+#if defined(BOOKGRASP_GOD_AVX2)
+  if (has_avx2()) {
+    switch (r) {
+      case 0:
+        return vote_clusters_planar_avx2_r<0>(bins, num_bins, out, colp);
+      case 1:
+        return vote_clusters_planar_avx2_r<1>(bins, num_bins, out, colp);
+      case 2:
+        return vote_clusters_planar_avx2_r<2>(bins, num_bins, out, colp);
+      case 3:
+        return vote_clusters_planar_avx2_r<3>(bins, num_bins, out, colp);
+      case 4:
+        return vote_clusters_planar_avx2_r<4>(bins, num_bins, out, colp);
+      case 5:
+        return vote_clusters_planar_avx2_r<5>(bins, num_bins, out, colp);
+      case 6:
+        return vote_clusters_planar_avx2_r<6>(bins, num_bins, out, colp);
+      default:
+        return vote_clusters_planar_avx2_r<7>(bins, num_bins, out, colp);
+    }
+  }
+#endif
   switch (r) {
     case 0:
       return vote_clusters_planar_r<0>(bins, num_bins, out, colp);
