@@ -838,6 +838,23 @@ void vote_clusters_into(const cv::Mat& bins, int num_bins, int n, cv::Mat& out, 
 #endif
 }
 
+/// Appends base + x for the pixels x0 <= x < x1 of the row `v` with a valid value, in order: four
+/// values tested at once (0 < v < inf, i.e. valid_value), the valid ones listed from the mask's bits.
+inline void push_valid_pixels(const float* v, int x0, int x1, int base, std::vector<int>& out) {
+  int x = x0;
+#if defined(__SSE2__)
+  const __m128 zero = _mm_setzero_ps(), inf = _mm_set1_ps(std::numeric_limits<float>::infinity());
+  for (; x + 4 <= x1; x += 4) {
+    const __m128 q = _mm_loadu_ps(v + x);
+    for (unsigned m = unsigned(_mm_movemask_ps(_mm_and_ps(_mm_cmpgt_ps(q, zero), _mm_cmplt_ps(q, inf)))); m != 0;
+         m &= m - 1)
+      out.push_back(base + x + __builtin_ctz(m));
+  }
+#endif
+  for (; x < x1; ++x)
+    if (valid_value(v[x])) out.push_back(base + x);
+}
+
 /// A maximal horizontal run of one initial segment in a row: columns x0..x1 of segment `label`.
 struct Run {
   int x0, x1, label;
@@ -1305,6 +1322,10 @@ SegmentationResult segment_god(const cv::Mat& image, const cv::Mat& points, cons
       for (size_t i = row_start[size_t(y)];; ++i) {
         const bool last = i == row_start[size_t(y) + 1];
         const int gap_end = last ? W : runs[i].x0;
+        if (image_space) {
+          push_valid_pixels(image.ptr<float>(y), x, gap_end, y * W, todo);
+          x = gap_end;
+        }
         for (; x < gap_end; ++x)
           if (merge_point(x, y, &v)) todo.push_back(y * W + x);
         if (last) break;
