@@ -143,6 +143,7 @@ void CoordinatorNode::on_servo_status(const servo_status_t& msg) {
   e.request_id = msg.request_id;
   e.mode = msg.mode;
   e.state = msg.state;
+  e.front_width_m = msg.front_width_m;
   e.message = msg.message;
   send(cycle_.on_servo(e), msg.utime);
   after_event(msg.utime);

@@ -38,6 +38,10 @@ struct CycleGeometry {
   double grasp_offset_x = 0.0;      ///< TCP below (-) / above (+) GP along X
   double grasp_offset_y = 0.0;      ///< TCP right (+) of GP along Y
   double insertion_depth = 0.02;    ///< TCP this far beyond GP along Z
+  /// > 0 (not in the paper): with the fore-edge's width measured by the corner servo, the plates open only this far
+  /// beyond the book on its left (the right plate stays where grasp_offset_y and the full opening put it), so the
+  /// open left plate lands on the neighbour next to the book, not on the one after it. 0 = always the full opening.
+  double width_left_clearance = 0.0;
   double pre_grasp_distance = 0.10; ///< pre-grasp pose this far in front of GP along -Z
   /// Deepest GP (grasp Z) the pre-grasp and the extraction's end are measured from: a deeper front (books
   /// pushed back by an earlier grasp's left plate) gets the pre-grasp and the extraction's end a front at this
@@ -102,6 +106,18 @@ double pre_grasp_back_off(double gp_z, const CycleGeometry& g);
 /// Pre-grasp pose: the grasp pose moved back along its z to `pre_grasp_distance` in front of GP, or in front
 /// of grasp Z `deep_front_z` when GP lies deeper (`gp_z`: GP's grasp Z, into the shelf).
 Eigen::Isometry3d pre_grasp_pose(const Eigen::Isometry3d& gp_base, double gp_z, const CycleGeometry& g);
+
+/// How far the plates open for a grasp and where the TCP goes along Y.
+struct PlateOpening {
+  double width = 0.0;     ///< plate gap (m)
+  double offset_y = 0.0;  ///< TCP right (+) of GP along Y (replaces CycleGeometry::grasp_offset_y)
+};
+
+/// The plates' opening for a fore-edge `front_width` wide (<= 0 or not finite: not measured) with the gripper's
+/// full opening `open_width`. The right plate's inner face stays open_width / 2 + grasp_offset_y right of GP; with
+/// width_left_clearance > 0 and a measured width the left one comes to front_width + width_left_clearance left of
+/// GP, unless that needs more than the full opening. Otherwise: {open_width, grasp_offset_y}.
+PlateOpening plate_opening(double front_width, double open_width, const CycleGeometry& g);
 /// Book height above its support at the TCP: GP.x (top above the upper shelf) plus the X offset.
 double tcp_height_on_book(const Eigen::Vector3d& gp_grasp, const CycleGeometry& g);
 /// TCP height above the book's bottom for the grasp from the holder: `tcp_height` (the grasp from the shelf)

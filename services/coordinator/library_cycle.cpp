@@ -355,13 +355,24 @@ void LibraryCycle::start_linear(std::vector<Eigen::Isometry3d> waypoints, double
   set_deadline(length / s_.linear_max_speed + s_.motion_margin_s);
 }
 
-void LibraryCycle::start_gripper(bool grasp) {
+PlateOpening LibraryCycle::grasp_opening() const {
+  return plate_opening(front_width_, s_.gripper_open_width, s_.geometry);
+}
+
+CycleGeometry LibraryCycle::grasp_geometry() const {
+  CycleGeometry g = s_.geometry;
+  g.grasp_offset_y = grasp_opening().offset_y;
+  return g;
+}
+
+void LibraryCycle::start_gripper(bool grasp, double open_width) {
   motion_ = Motion{};
   motion_.kind = grasp ? MotionKind::kGripperGrasp : MotionKind::kGripperOpen;
+  motion_.open_width = open_width > 0 ? open_width : s_.gripper_open_width;
   CycleRequest r;
   r.kind = grasp ? CycleRequest::Kind::kGripperGrasp : CycleRequest::Kind::kGripperMove;
   r.id = next_id();
-  r.width = grasp ? 0.0 : s_.gripper_open_width;
+  r.width = grasp ? 0.0 : motion_.open_width;
   r.force = s_.gripper_force;
   r.speed = s_.gripper_speed;
   out_.push_back(r);
@@ -460,7 +471,7 @@ void LibraryCycle::drive_motion(const ArmEvent& e) {
       const bool settled = static_cast<double>(now_ - motion_.settle_start) >= s_.gripper_settle_s * 1e6;
       if (!settled) return;
       if (motion_.kind == MotionKind::kGripperOpen) {
-        if (w >= s_.gripper_open_width - s_.gripper_open_tolerance) motion_done();
+        if (w >= motion_.open_width - s_.gripper_open_tolerance) motion_done();
         return;
       }
       if (e.gripper_contact || w < s_.min_book_width) handle_gripper_result(w, e.gripper_contact);
@@ -642,7 +653,7 @@ void LibraryCycle::enter(CycleState s) {
     case CycleState::kBackOut: {
       out_.push_back(make_request(CycleRequest::Kind::kGripperMove));
       out_.back().id = next_id();
-      out_.back().width = s_.gripper_open_width;
+      out_.back().width = grasp_opening().width;  // not wider than for the grasp: the plates are among the books
       out_.back().force = s_.gripper_force;
       out_.back().speed = s_.gripper_speed;
       const Eigen::Isometry3d here = arm_->end_effector;
@@ -694,6 +705,7 @@ void LibraryCycle::enter(CycleState s) {
       r.kind = CycleRequest::Kind::kServo;
       r.id = next_id();
       servo_request_ = r.id;
+      front_width_ = 0.0;
       r.servo_mode = kServoBookCorner;
       r.pose = arm_ ? arm_->end_effector : bwh_start_pose(cart_frame(), bwh_start_, g);
       r.rank = rank_;
@@ -717,22 +729,25 @@ void LibraryCycle::enter(CycleState s) {
       break;
     case CycleState::kMoveToPreGrasp: {
       // INSERT and EXTRACT follow: the planner picks a posture from which the arm can make them.
-      const Eigen::Isometry3d grasp = grasp_pose(gp_base_, g);
+      const CycleGeometry gw = grasp_geometry();
+      const Eigen::Isometry3d grasp = grasp_pose(gp_base_, gw);
       std::vector<Eigen::Isometry3d> then{grasp};
       for (const Eigen::Isometry3d& p : extract_moves(grasp, cart_frame(), tcp_height(),
                                                       moves_front_z(progress_.gp_grasp.z(), g) + g.insertion_depth, g))
         then.push_back(p);
-      start_planned_pose(pre_grasp_pose(gp_base_, progress_.gp_grasp.z(), g), false, std::move(then));
+      start_planned_pose(pre_grasp_pose(gp_base_, progress_.gp_grasp.z(), gw), false, std::move(then));
       break;
     }
     case CycleState::kOpenForGrasp:
+      start_gripper(false, grasp_opening().width);
+      break;
     case CycleState::kOpenForHolderGrasp:
     case CycleState::kReleaseOnHolder:
     case CycleState::kReleaseOnLowerShelf:
       start_gripper(false);
       break;
     case CycleState::kInsert:
-      start_linear({grasp_pose(gp_base_, g)});
+      start_linear({grasp_pose(gp_base_, grasp_geometry())});
       break;
     case CycleState::kCloseGripper:
     case CycleState::kGraspFromHolder:
@@ -1102,6 +1117,8 @@ std::vector<CycleRequest> LibraryCycle::on_servo(const ServoEvent& e) {
     else
       fail("stripe servo ended " + servo_state_name(e.state) + (e.message.empty() ? "" : ": " + e.message));
   } else if (state_ == CycleState::kServoBook && e.request_id == servo_request_ && terminal) {
+    if (e.state == kServoConverged && std::isfinite(e.front_width_m) && e.front_width_m > 0)
+      front_width_ = e.front_width_m;
     // Converged or not, the arbiter decides (a failed BwH servo is its NO_GRASP).
     succeed(CycleState::kWaitDecision);
   }

@@ -130,6 +130,7 @@ struct ServoEvent {
   int64_t request_id = 0;
   int mode = 0;   ///< servo_request_t mode
   int state = 0;  ///< servo_status_t state
+  double front_width_m = 0;  ///< BOOK_CORNER CONVERGED: the fore-edge's width from the servo (0 = not measured)
   std::string message;
 };
 
@@ -288,6 +289,7 @@ class LibraryCycle {
     int64_t stall_since = -1;
     int64_t settle_start = -1;
     double settle_width = 0;
+    double open_width = 0;  ///< kGripperOpen: the commanded plate gap
   };
 
   void advance_time(int64_t utime);
@@ -303,7 +305,12 @@ class LibraryCycle {
   void start_planned_pose(const Eigen::Isometry3d& goal, bool holding, std::vector<Eigen::Isometry3d> then = {});
   /// Straight moves through `waypoints`; `guard` > 0: the arm stalling within it of the last one ends the move.
   void start_linear(std::vector<Eigen::Isometry3d> waypoints, double guard = 0);
-  void start_gripper(bool grasp);
+  /// Closes the plates (grasp) or opens them to `open_width` (<= 0: the full opening).
+  void start_gripper(bool grasp, double open_width = 0);
+  /// This attempt's plate opening for the grasp (plate_opening() with the corner servo's fore-edge width).
+  PlateOpening grasp_opening() const;
+  /// The geometry with this attempt's grasp_opening() offset.
+  CycleGeometry grasp_geometry() const;
   void issue_plan();
   void drive_motion(const ArmEvent& e);
   /// After a move that carries the book: if the plates closed on nothing (no contact, narrower than
@@ -357,6 +364,7 @@ class LibraryCycle {
       0.0;  ///< grasp Z of the book's front for the corner servo: P1.z when P1 is valid, else the model's
   std::optional<DecisionEvent> early_decision_;  ///< a decision that arrived before its servo status
   Eigen::Isometry3d gp_base_ = Eigen::Isometry3d::Identity();
+  double front_width_ = 0.0;  ///< this attempt's fore-edge width from the corner servo (0 = not measured)
   bool user_event_sent_ = false;
   bool stopping_foreign_motion_ = false;  ///< started with the arm executing a motion it did not command
   int64_t last_foreign_stop_utime_ = 0;   ///< when that motion was last sent a STOP

@@ -1,5 +1,6 @@
 #include "services/visual_servo/servo_session.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 
@@ -176,6 +177,7 @@ SessionOutput ServoSession::on_request(const ServoRequest& request) {
   holding_ = false;
   last_lost_reason_.clear();
   sightings_.clear();
+  sighting_widths_px_.clear();
   start_position_ = tcp_.translation();
   twist_.setZero();
   corner_.reset();
@@ -223,6 +225,18 @@ Eigen::Vector3d ServoSession::moved_since(int64_t capture_utime) const {
   return Eigen::Vector3d(d.x(), d.y(), std::atan2(turned(1, 0), turned(0, 0)));
 }
 
+double ServoSession::front_width_at(const Eigen::Vector3d& corner_in_base) const {
+  std::vector<double> widths;
+  for (size_t i = 0; i < sightings_.size(); ++i) {
+    const double depth = (sightings_[i].camera_in_base.inverse() * corner_in_base).z();
+    if (sighting_widths_px_[i] > 0 && depth > 0)
+      widths.push_back(sighting_widths_px_[i] * depth / geo_.intrinsics().fx);
+  }
+  if (widths.empty()) return 0.0;
+  std::nth_element(widths.begin(), widths.begin() + static_cast<long>(widths.size() / 2), widths.end());
+  return widths[widths.size() / 2];
+}
+
 SessionOutput ServoSession::on_book(const BookObservation& obs) {
   SessionOutput out;
   advance(obs.utime, &out);
@@ -241,17 +255,23 @@ SessionOutput ServoSession::on_book(const BookObservation& obs) {
   last_good_utime_ = now_;  // arrival (message time), see advance()
   holding_ = false;
   const std::optional<Eigen::Isometry3d> at_capture = pose_at(obs.utime);
-  if (at_capture) sightings_.push_back({*at_capture * geo_.camera_in_gripper(), obs.r_px});
+  if (at_capture) {
+    sightings_.push_back({*at_capture * geo_.camera_in_gripper(), obs.r_px});
+    sighting_widths_px_.push_back(obs.width_px);
+  }
   if (s.converged) {
     std::string why;
     const std::optional<TriangulatedCorner> corner =
         triangulate_corner(sightings_, geo_.intrinsics(), p_.corner_triangulation, &why);
     std::string message =
         fmt("R within %.2f px of the target (%.1f, %.1f)", s.error_px.norm(), s.target_px.x(), s.target_px.y());
+    double front_width = 0;
     if (corner) {
       const Eigen::Vector3d in_tcp = at_capture ? at_capture->inverse() * corner->point : Eigen::Vector3d::Zero();
       message += fmt("; R triangulated %.1f mm ahead of the TCP", in_tcp.z() * 1e3) +
                  fmt(" from %.0f views over %.1f mm", corner->sightings, corner->baseline_m * 1e3);
+      front_width = front_width_at(corner->point);
+      if (front_width > 0) message += fmt("; fore-edge %.1f mm wide", front_width * 1e3);
     } else {
       message += "; R not triangulated: " + why;
     }
@@ -263,7 +283,10 @@ SessionOutput ServoSession::on_book(const BookObservation& obs) {
       message += fmt("; P2 is the TCP raised by %.1f mm (book_corner.target_above_tcp_m)", above * 1e3);
     }
     finish(ServoState::kConverged, message, &out, p2);
-    if (!out.reports.empty()) out.reports.back().corner = corner;
+    if (!out.reports.empty()) {
+      out.reports.back().corner = corner;
+      out.reports.back().front_width_m = front_width;
+    }
     return out;
   }
   command(s.twist, &out);

@@ -80,6 +80,7 @@ struct BookObservation {
   int rank_from_right = 0;
   Eigen::Vector2d r_px = Eigen::Vector2d::Zero();
   double slope_rad = 0;
+  double width_px = 0;  ///< the selected fore-edge's width at its top (book_width_px); <= 0 = not given
 };
 
 /// A command for the arm driver.
@@ -104,6 +105,9 @@ struct ServoReport {
   /// BOOK_CORNER CONVERGED only: R triangulated from the task's views, when they allowed it (else the
   /// message says why not).
   std::optional<TriangulatedCorner> corner;
+  /// BOOK_CORNER CONVERGED with `corner`: the fore-edge's width in metres, the median over the task's views of
+  /// width_px x (R's depth in that view's camera) / fx; 0 when R was not triangulated or no view gave a width.
+  double front_width_m = 0;
   std::string message;
 };
 
@@ -142,6 +146,8 @@ class ServoSession {
   int64_t now_utime() const { return now_; }
 
  private:
+  /// The fore-edge's width (m) from the views' widths at `corner_in_base` (see ServoReport::front_width_m).
+  double front_width_at(const Eigen::Vector3d& corner_in_base) const;
   void advance(int64_t utime, SessionOutput* out);
   void finish(ServoState state, const std::string& message, SessionOutput* out,
               const std::optional<Eigen::Isometry3d>& pose = std::nullopt);
@@ -183,6 +189,7 @@ class ServoSession {
   double slope_error_ = 0;
   std::string last_lost_reason_;
   std::vector<CornerSighting> sightings_;  ///< the corner task's views of R (camera pose at capture, pixel)
+  std::vector<double> sighting_widths_px_;  ///< BwH's fore-edge width in each of sightings_ (<= 0: none)
 };
 
 }  // namespace bookgrasp

@@ -137,6 +137,7 @@ void VisualServoNode::emit(const SessionOutput& out) {
     for (int i = 0; i < 3; ++i) m.corner_base[i] = r.corner ? r.corner->point(i) : 0.0;
     m.corner_baseline_m = r.corner ? r.corner->baseline_m : 0.0;
     m.corner_rms_px = r.corner ? r.corner->rms_px : 0.0;
+    m.front_width_m = r.front_width_m;
     m.message = r.message;
     publish(settings_.servo_status_channel, m);
   }
@@ -199,6 +200,7 @@ void VisualServoNode::on_book(const book_features_hand_t& msg) {
   o.rank_from_right = msg.rank_from_right;
   o.r_px = Eigen::Vector2d(msg.r_px[0], msg.r_px[1]);
   o.slope_rad = msg.slope_rad;
+  o.width_px = std::isfinite(msg.book_width_px) ? msg.book_width_px : 0.0;
   if (msg.found && (!o.r_px.allFinite() || !std::isfinite(o.slope_rad))) {
     reject(settings_.book_features_channel, "found=true but r_px or slope_rad is not finite");
     return;

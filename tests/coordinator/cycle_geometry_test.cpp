@@ -32,6 +32,26 @@ CycleGeometry geometry() {
   return g;
 }
 
+TEST(CycleGeometry, AMeasuredForeEdgeNarrowsThePlatesOnTheLeftOnly) {
+  CycleGeometry g;
+  g.grasp_offset_y = -0.015;  // full 6 cm opening: right plate 15 mm right of GP, left plate 45 mm left of it
+  g.width_left_clearance = 0.008;
+  // A 12 mm fore-edge: the left plate's inner face 8 mm left of the book, the right one where it was.
+  const PlateOpening narrow = plate_opening(0.012, 0.06, g);
+  EXPECT_NEAR(narrow.width, 0.035, 1e-12);
+  EXPECT_NEAR(narrow.offset_y + 0.5 * narrow.width, 0.015, 1e-12);   // right plate
+  EXPECT_NEAR(narrow.offset_y - 0.5 * narrow.width, -0.020, 1e-12);  // left plate: 12 + 8 mm left of GP
+  // Not measured (0, NaN, negative), switched off, or a book that needs the full opening: the paper's full opening.
+  for (const double w : {0.0, double(NAN), -0.01, 0.040}) {
+    const PlateOpening full = plate_opening(w, 0.06, g);
+    EXPECT_EQ(full.width, 0.06) << w;
+    EXPECT_EQ(full.offset_y, -0.015) << w;
+  }
+  CycleGeometry off = g;
+  off.width_left_clearance = 0.0;
+  EXPECT_EQ(plate_opening(0.012, 0.06, off).width, 0.06);
+}
+
 TEST(CycleGeometry, TheCornerServoStandoffReachesTheBooksFront) {
   const CycleGeometry g = geometry();
   EXPECT_NEAR(servo_standoff(0.012, g), 0.112, 1e-12);  // TCP at Z -0.10, front at +0.012

@@ -324,6 +324,44 @@ TEST(LibraryCycle, AMissedGraspFromTheHolderBacksOutStraightBeforePlanning) {
   EXPECT_EQ(cycle.progress().failures, 1);
 }
 
+TEST(LibraryCycle, AForeEdgeWidthFromTheCornerServoOpensThePlatesOnlySoFar) {
+  // coordinator.yaml: open_width_m 0.06, offset_y_m -0.015 (right plate 15 mm right of GP), width_left_clearance 8 mm.
+  const CycleSettings cs = settings();
+  ASSERT_NEAR(cs.geometry.width_left_clearance, 0.008, 1e-12);
+  ASSERT_NEAR(cs.gripper_open_width, 0.06, 1e-12);
+  for (const bool measured : {false, true}) {
+    SCOPED_TRACE(measured ? "width measured" : "no width");
+    FakeLibrary w(three_books());
+    w.servo_measures_width = measured;
+    LibraryCycle cycle(cs, std::nullopt);
+    w.run(cycle, [&] { return done_or_aborted(cycle); });
+    ASSERT_EQ(cycle.state(), CycleState::kDone) << cycle.status().message;
+    // Each book's pre-grasp plan, the first plan after its corner servo (its first straight move is INSERT's pose),
+    // and the opening right after it.
+    size_t book = 0;
+    bool after_servo = false;
+    for (size_t i = 0; i < w.requests.size() && book < 3; ++i) {
+      const CycleRequest& q = w.requests[i];
+      if (q.kind == CycleRequest::Kind::kServo && q.servo_mode == 1) after_servo = true;
+      if (q.kind != CycleRequest::Kind::kPlan || !after_servo) continue;
+      after_servo = false;
+      ASSERT_FALSE(q.then_poses.empty());
+      const FakeBook b = three_books()[book];
+      const double width = measured ? b.width + 0.015 + 0.008 : 0.06;
+      const double right_plate = 0.015, left_plate = measured ? -(b.width + 0.008) : -0.045;
+      const Eigen::Vector3d insert = hand_grasp_frame().inverse() * q.then_poses.front().translation();
+      EXPECT_NEAR(insert.y() - b.right_y + 0.5 * width, right_plate, 1e-9) << "book " << book;
+      EXPECT_NEAR(insert.y() - b.right_y - 0.5 * width, left_plate, 1e-9) << "book " << book;
+      size_t j = i + 1;
+      while (j < w.requests.size() && w.requests[j].kind != CycleRequest::Kind::kGripperMove) ++j;
+      ASSERT_LT(j, w.requests.size());
+      EXPECT_NEAR(w.requests[j].width, width, 1e-12) << "book " << book;
+      ++book;
+    }
+    EXPECT_EQ(book, 3u);
+  }
+}
+
 TEST(LibraryCycle, TheArbitersFrontDepthSetsTheCornerServosStandoff) {
   // coordinator.yaml: book_front_z_m 0.01 (when the arbiter gives no depth), bwh_start_z_m -0.08.
   const CycleSettings cs = settings();

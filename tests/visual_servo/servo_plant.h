@@ -47,13 +47,16 @@ inline Eigen::Isometry3d integrate(const Eigen::Isometry3d& tcp, const GripperTw
 struct CornerScene {
   Eigen::Vector3d corner{0.0, 0.0, 0.3};
   double roll_rad = 0.0;
+  double width_m = 0.03;  ///< the top edge's length (the fore-edge's width)
 
-  /// Pixel of R and image slope (atan2(dy, dx)) seen from `tcp` (W).
-  bool observe(const HandEyeGeometry& g, const Eigen::Isometry3d& tcp, Eigen::Vector2d* r, double* slope) const {
+  /// Pixel of R and image slope (atan2(dy, dx)) seen from `tcp` (W); the top edge's width in image columns (as
+  /// page_face_detection measures it) in `width_px` if given.
+  bool observe(const HandEyeGeometry& g, const Eigen::Isometry3d& tcp, Eigen::Vector2d* r, double* slope,
+               double* width_px = nullptr) const {
     const Eigen::Isometry3d cam = tcp * g.camera_in_gripper();
     // Top edge goes left from R: direction -Y rolled about Z.
     const Eigen::Vector3d dir = Eigen::AngleAxisd(roll_rad, Eigen::Vector3d::UnitZ()) * Eigen::Vector3d(0, -1, 0);
-    const Eigen::Vector3d a = cam.inverse() * corner, b = cam.inverse() * (corner + 0.03 * dir);
+    const Eigen::Vector3d a = cam.inverse() * corner, b = cam.inverse() * (corner + width_m * dir);
     if (a.z() <= 0 || b.z() <= 0) return false;
     const auto& k = g.intrinsics();
     const Eigen::Vector2d pa(k.cx + k.fx * a.x() / a.z(), k.cy + k.fy * a.y() / a.z());
@@ -62,6 +65,7 @@ struct CornerScene {
     *r = pa;
     const Eigen::Vector2d d = pa - pb;  // left-to-right along the edge
     *slope = std::atan2(d.y(), d.x());
+    if (width_px) *width_px = std::abs(d.x());
     return true;
   }
 };

@@ -321,7 +321,7 @@ TEST(StripeServoLatency, ImagesASecondLateStillConvergeOnTheTrueEnd) {
 /// start and `corner_z` ahead of it (the servo assumes 0.22 m), its top edge rolled 3 degrees. Returns the final
 /// report.
 ServoReport run_late_corner(double latency_s, bool compensate, double corner_z = 0.22, double target_above_m = 0.0,
-                            Eigen::Isometry3d* final_tcp = nullptr) {
+                            Eigen::Isometry3d* final_tcp = nullptr, bool bwh_gives_width = true) {
   const HandEyeGeometry geo = test::project_geometry();
   BookCornerServoParams cp;
   cp.target_above_tcp_m = target_above_m;
@@ -345,7 +345,7 @@ ServoReport run_late_corner(double latency_s, bool compensate, double corner_z =
   const auto capture = [&](int64_t t, const Eigen::Isometry3d& at) {
     BookObservation o;
     o.utime = t;
-    o.found = scene.observe(geo, at, &o.r_px, &o.slope_rad);
+    o.found = scene.observe(geo, at, &o.r_px, &o.slope_rad, bwh_gives_width ? &o.width_px : nullptr);
     return o;
   };
   const auto [report, tcp] =
@@ -404,8 +404,17 @@ TEST(CornerServoTriangulation, TheConvergedReportLocatesRAtItsTrueDepth) {
       EXPECT_GT(report.corner->baseline_m, 0.04);  // the servo moved 5 cm
       EXPECT_LT(report.corner->rms_px, 0.5);
       EXPECT_NE(report.message.find("R triangulated"), std::string::npos) << report.message;
+      // The fore-edge's width (the scene's top edge, 3 cm) from BwH's widths at R's triangulated depth: right where
+      // the assumed standoff is not.
+      EXPECT_NEAR(report.front_width_m, 0.03, 1e-3) << report.message;
+      EXPECT_NE(report.message.find("fore-edge 30."), std::string::npos) << report.message;
     }
   }
+  // Without BwH widths there is no width (0), and the message gives none.
+  const ServoReport no_width = run_late_corner(0.0, true, 0.22, 0.0, nullptr, false);
+  ASSERT_EQ(no_width.state, ServoState::kConverged) << no_width.message;
+  EXPECT_EQ(no_width.front_width_m, 0.0);
+  EXPECT_EQ(no_width.message.find("fore-edge"), std::string::npos) << no_width.message;
   // The assumed depth's error shows in the converged pose's X, not in the triangulated corner.
   const ServoReport deep = run_late_corner(0.0, true, 0.28);
   EXPECT_GT(std::abs(deep.converged_pose->translation().x() - 0.04), 0.01);
