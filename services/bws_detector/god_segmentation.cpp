@@ -7,6 +7,7 @@
 #include <limits>
 #include <numeric>
 #include <stdexcept>
+#include <type_traits>
 #include <vector>
 
 #include <Eigen/Eigenvalues>
@@ -717,48 +718,38 @@ GOD_TARGET_AVX2 void vote_clusters_planar_avx2_r(const cv::Mat& bins, int num_bi
 }
 #endif
 
+/// Calls fn(std::integral_constant<int, R>{}) for the window's half size r (0..7; larger r: 7), so a kernel
+/// templated on R is instantiated once per size.
+template <typename Fn>
+void with_half_size(int r, Fn&& fn) {
+  switch (r) {
+    case 0:
+      return fn(std::integral_constant<int, 0>{});
+    case 1:
+      return fn(std::integral_constant<int, 1>{});
+    case 2:
+      return fn(std::integral_constant<int, 2>{});
+    case 3:
+      return fn(std::integral_constant<int, 3>{});
+    case 4:
+      return fn(std::integral_constant<int, 4>{});
+    case 5:
+      return fn(std::integral_constant<int, 5>{});
+    case 6:
+      return fn(std::integral_constant<int, 6>{});
+    default:
+      return fn(std::integral_constant<int, 7>{});
+  }
+}
+
 /// vote_clusters_planar_r for the window's half size r (0..7).
 void vote_clusters_planar(const cv::Mat& bins, int num_bins, int r, cv::Mat& out, std::vector<uint8_t>& colp) {
 #if defined(BOOKGRASP_GOD_AVX2)
-  if (has_avx2()) {
-    switch (r) {
-      case 0:
-        return vote_clusters_planar_avx2_r<0>(bins, num_bins, out, colp);
-      case 1:
-        return vote_clusters_planar_avx2_r<1>(bins, num_bins, out, colp);
-      case 2:
-        return vote_clusters_planar_avx2_r<2>(bins, num_bins, out, colp);
-      case 3:
-        return vote_clusters_planar_avx2_r<3>(bins, num_bins, out, colp);
-      case 4:
-        return vote_clusters_planar_avx2_r<4>(bins, num_bins, out, colp);
-      case 5:
-        return vote_clusters_planar_avx2_r<5>(bins, num_bins, out, colp);
-      case 6:
-        return vote_clusters_planar_avx2_r<6>(bins, num_bins, out, colp);
-      default:
-        return vote_clusters_planar_avx2_r<7>(bins, num_bins, out, colp);
-    }
-  }
+  if (has_avx2())
+    return with_half_size(r,
+                          [&](auto R) { vote_clusters_planar_avx2_r<decltype(R)::value>(bins, num_bins, out, colp); });
 #endif
-  switch (r) {
-    case 0:
-      return vote_clusters_planar_r<0>(bins, num_bins, out, colp);
-    case 1:
-      return vote_clusters_planar_r<1>(bins, num_bins, out, colp);
-    case 2:
-      return vote_clusters_planar_r<2>(bins, num_bins, out, colp);
-    case 3:
-      return vote_clusters_planar_r<3>(bins, num_bins, out, colp);
-    case 4:
-      return vote_clusters_planar_r<4>(bins, num_bins, out, colp);
-    case 5:
-      return vote_clusters_planar_r<5>(bins, num_bins, out, colp);
-    case 6:
-      return vote_clusters_planar_r<6>(bins, num_bins, out, colp);
-    default:
-      return vote_clusters_planar_r<7>(bins, num_bins, out, colp);
-  }
+  with_half_size(r, [&](auto R) { vote_clusters_planar_r<decltype(R)::value>(bins, num_bins, out, colp); });
 }
 #else
 template <typename C>
