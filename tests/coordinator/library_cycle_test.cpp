@@ -325,13 +325,18 @@ TEST(LibraryCycle, AMissedGraspFromTheHolderBacksOutStraightBeforePlanning) {
 }
 
 TEST(LibraryCycle, AForeEdgeWidthFromTheCornerServoOpensThePlatesOnlySoFar) {
-  // coordinator.yaml: open_width_m 0.06, offset_y_m -0.015 (right plate 15 mm right of GP), width_left_clearance 8 mm.
-  const CycleSettings cs = settings();
-  ASSERT_NEAR(cs.geometry.width_left_clearance, 0.008, 1e-12);
-  ASSERT_NEAR(cs.gripper_open_width, 0.06, 1e-12);
-  for (const bool measured : {false, true}) {
-    SCOPED_TRACE(measured ? "width measured" : "no width");
+  // coordinator.yaml: open_width_m 0.06, offset_y_m -0.015 (right plate 15 mm right of GP); width_left_clearance_m is
+  // shipped off (0), set to 8 mm here.
+  const CycleSettings shipped = settings();
+  ASSERT_EQ(shipped.geometry.width_left_clearance, 0.0);
+  ASSERT_NEAR(shipped.gripper_open_width, 0.06, 1e-12);
+  for (const auto& [clearance, width_given] : {std::pair{0.008, false}, std::pair{0.008, true}, std::pair{0.0, true}}) {
+    SCOPED_TRACE("clearance " + std::to_string(clearance) + (width_given ? ", width measured" : ", no width"));
+    CycleSettings cs = shipped;
+    cs.geometry.width_left_clearance = clearance;
+    const bool measured = width_given && clearance > 0;  // the opening follows the width
     FakeLibrary w(three_books());
+    w.servo_measures_width = width_given;
     w.servo_measures_width = measured;
     LibraryCycle cycle(cs, std::nullopt);
     w.run(cycle, [&] { return done_or_aborted(cycle); });
