@@ -168,6 +168,7 @@ CycleSettings CycleSettings::from_config(const Config& root) {
   s.auto_done_after_s = root.get_double("user.auto_done_after_s", 0, 1e6);
   s.max_attempts_per_book = root.get_int("retries.max_attempts_per_book", 1, 100);
   s.max_step_retries = root.get_int("retries.max_step_retries", 0, 100);
+  s.hand_over_unplaceable = root.get<bool>("retries.hand_over_unplaceable");
   const Config p = root.child("planning");
   s.planner = p.get<std::string>("planner");
   s.plan_time_budget_s = p.get_double("time_budget_s", 0.01, 120);
@@ -256,6 +257,10 @@ double LibraryCycle::held_box_height() const {
 }
 double LibraryCycle::tcp_height() const {
   return tcp_height_on_book(progress_.gp_grasp, s_.geometry);
+}
+double LibraryCycle::holder_tcp_height() const {
+  return progress_.place == BookPlace::kInGripperFromHolder ? holder_regrasp_height(tcp_height(), s_.geometry)
+                                                            : tcp_height();
 }
 
 void LibraryCycle::advance_time(int64_t utime) {
@@ -560,7 +565,8 @@ void LibraryCycle::after_motion() {
       succeed(CycleState::kParkForUser);
       return;
     case CycleState::kParkForUser:
-      succeed(CycleState::kWaitUser);
+      // A book the lower shelf could not take was catalogued already: it waits for the librarian, not the user.
+      succeed(progress_.hand_over_reason.empty() ? CycleState::kWaitUser : CycleState::kWaitBookTaken);
       return;
     case CycleState::kMoveToHolderPreGrasp:
       succeed(CycleState::kOpenForHolderGrasp);
@@ -617,6 +623,7 @@ void LibraryCycle::book_done(bool handed_over) {
     progress_.lower_next_right_y = next_lower_right_y(progress_.lower_next_right_y, progress_.book_width, g);
   progress_.place = BookPlace::kUpperShelf;
   progress_.have_book_data = false;
+  progress_.hand_over_reason.clear();
   const std::string where = handed_over ? " taken off the holder by the librarian" : " on the lower shelf";
   // Rule (a): the room left of this book, up to the shelf's left end, cannot hold an admissible book.
   const double room = b.gp_y - b.width - g.shelf_left_y;
@@ -760,13 +767,14 @@ void LibraryCycle::enter(CycleState s) {
     }
     case CycleState::kMoveToHolder: {
       // PLACE_ON_HOLDER and RETREAT_FROM_HOLDER follow.
-      std::vector<Eigen::Isometry3d> then = holder_place_moves(holder_frame(), tcp_height(), g);
+      // A book going back to the holder (return_to_holder) sits lower in the plates: its grasp from the holder's.
+      std::vector<Eigen::Isometry3d> then = holder_place_moves(holder_frame(), holder_tcp_height(), g);
       then.push_back(move_along_own_axes(then.back(), Eigen::Vector3d(0, 0, -g.holder_retreat)));
-      start_planned_pose(holder_pre_place_pose(holder_frame(), tcp_height(), g), true, std::move(then));
+      start_planned_pose(holder_pre_place_pose(holder_frame(), holder_tcp_height(), g), true, std::move(then));
       break;
     }
     case CycleState::kPlaceOnHolder:
-      start_linear(holder_place_moves(holder_frame(), tcp_height(), g), g.holder_place_guard);
+      start_linear(holder_place_moves(holder_frame(), holder_tcp_height(), g), g.holder_place_guard);
       break;
     case CycleState::kApproachHolder:
       start_linear({holder_place_pose(holder_frame(), holder_regrasp_height(tcp_height(), g), g)});
@@ -782,6 +790,12 @@ void LibraryCycle::enter(CycleState s) {
       break;
     case CycleState::kWaitBookTaken:
       set_deadline(s_.user_timeout_s);
+      if (!progress_.hand_over_reason.empty()) {
+        message_ = "book " + std::to_string(progress_.books_moved) +
+                   " is back on the holder: the lower shelf could not take it (" + progress_.hand_over_reason +
+                   "); take it off and send \"taken\"";
+        break;
+      }
       message_ = "book " + std::to_string(progress_.books_moved) + " is " + mm(held_box_height()) +
                  " tall: the lower shelf takes books up to " + mm(lower_shelf_max_book_height(g)) +
                  " (lower_shelf.gap_to_upper_shelf_m - 2 x book_clearance_m); it stays on the holder: take it off "
@@ -809,9 +823,8 @@ void LibraryCycle::enter(CycleState s) {
     case CycleState::kMoveToLowerShelf: {
       const double left_after = progress_.lower_next_right_y - progress_.book_width;
       if (left_after < g.lower_left_y) {
-        abort("the lower shelf is full: book " + std::to_string(progress_.books_moved) + " (" +
-              mm(progress_.book_width) + ") does not fit right of " + mm(g.lower_left_y) +
-              " (it stays in the gripper)");
+        return_to_holder("the lower shelf is full: book " + std::to_string(progress_.books_moved) + " (" +
+                         mm(progress_.book_width) + ") does not fit right of " + mm(g.lower_left_y));
         return;
       }
       // PLACE_ON_LOWER_SHELF and RETREAT_FROM_LOWER_SHELF follow.
@@ -838,7 +851,11 @@ void LibraryCycle::enter(CycleState s) {
         std::count_if(progress_.moved.begin(), progress_.moved.end(), [](const MovedBook& b) { return b.handed_over; });
     message_ =
         "upper shelf done: " + std::to_string(progress_.books_moved) + " books moved" +
-        (handed > 0 ? " (" + std::to_string(handed) + " of them too tall, left to the librarian on the holder)" : "") +
+        (handed > 0
+             ? " (" + std::to_string(handed) +
+                   " of them left to the librarian on the holder: too tall for the lower shelf, or not placeable "
+                   "there)"
+             : "") +
         (message_.empty() ? "" : " (" + message_ + ")");
   }
   persist();
@@ -868,6 +885,11 @@ void LibraryCycle::fail(const std::string& reason) {
     enter(inside ? CycleState::kBackOut : CycleState::kPark);
     return;
   }
+  if (step_retries_ >= s_.max_step_retries && state_ == CycleState::kMoveToLowerShelf) {
+    return_to_holder(cycle_state_name(state_) + " failed " + std::to_string(step_retries_ + 1) +
+                     " times (retries.max_step_retries), last: " + reason);
+    return;
+  }
   if (step_retries_ >= s_.max_step_retries) {
     abort(cycle_state_name(state_) + " failed " + std::to_string(step_retries_ + 1) +
           " times (retries.max_step_retries), last: " + reason + "; the book is on/in the " +
@@ -880,6 +902,18 @@ void LibraryCycle::fail(const std::string& reason) {
   // "start is in collision", the deployed demo's third book), then come back from the pre-grasp pose.
   const CycleState again = state_ == CycleState::kGraspFromHolder ? CycleState::kBackOutFromHolder : state_;
   enter(again);
+}
+
+void LibraryCycle::return_to_holder(const std::string& why) {
+  if (!s_.hand_over_unplaceable || !progress_.hand_over_reason.empty()) {
+    abort(why + "; the book is on/in the " + book_place_name(progress_.place) +
+          (s_.hand_over_unplaceable ? "" : " (retries.hand_over_unplaceable is off)"));
+    return;
+  }
+  progress_.hand_over_reason = why;
+  message_ = "book " + std::to_string(progress_.books_moved) + " goes back onto the holder for the librarian: " + why;
+  step_retries_ = 0;
+  enter(CycleState::kMoveToHolder);
 }
 
 void LibraryCycle::abort(const std::string& reason) {
@@ -912,6 +946,8 @@ CycleState LibraryCycle::resume_target() const {
         return CycleState::kBackOutFromHolder;
       return CycleState::kParkForUser;
     case BookPlace::kInGripperFromHolder:
+      if (!progress_.hand_over_reason.empty())  // on its way back to the holder for the librarian
+        return in(was, {CycleState::kPlaceOnHolder}) ? CycleState::kPlaceOnHolder : CycleState::kMoveToHolder;
       if (in(was, {CycleState::kGraspFromHolder, CycleState::kLiftFromHolder})) return CycleState::kLiftFromHolder;
       if (in(was, {CycleState::kPlaceOnLowerShelf})) return CycleState::kPlaceOnLowerShelf;
       return CycleState::kMoveToLowerShelf;

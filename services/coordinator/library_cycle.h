@@ -57,6 +57,9 @@ struct CycleSettings {
   // retries
   int max_attempts_per_book = 3;
   int max_step_retries = 2;
+  /// Not in the paper: a book the lower shelf cannot take (its move there still fails after the step retries, or
+  /// the shelf is full) goes back onto the holder for the librarian (WAIT_BOOK_TAKEN) instead of aborting the task.
+  bool hand_over_unplaceable = true;
   // planner
   std::string planner;  ///< "" = the planner's default
   double plan_time_budget_s = 2;
@@ -210,8 +213,9 @@ enum class CycleState {
   kRetreatFromHolder,
   kParkForUser,
   kWaitUser,
-  /// Not in the paper: the book is taller than the lower shelf takes (lower_shelf_max_book_height): it stays on
-  /// the holder until the librarian takes it off and sends USER_EVENT "taken"; then the next book.
+  /// Not in the paper: the book is taller than the lower shelf takes (lower_shelf_max_book_height), or the lower
+  /// shelf could not take it (hand_over_unplaceable): it stays on the holder until the librarian takes it off and
+  /// sends USER_EVENT "taken"; then the next book.
   kWaitBookTaken,
   kMoveToHolderPreGrasp,
   kOpenForHolderGrasp,
@@ -329,6 +333,12 @@ class LibraryCycle {
   Eigen::Isometry3d cart_frame() const;
   Eigen::Isometry3d holder_frame() const;
   double tcp_height() const;
+  /// TCP height above the held book's bottom for the holder's place poses: tcp_height() for a book from the upper
+  /// shelf, the grasp from the holder's (holder_regrasp_height) for one going back to the holder.
+  double holder_tcp_height() const;
+  /// The lower shelf cannot take the held book (`why`): with hand_over_unplaceable it goes back onto the holder
+  /// for the librarian (MOVE_TO_HOLDER ... WAIT_BOOK_TAKEN), else the task aborts with the book held.
+  void return_to_holder(const std::string& why);
   /// Height of the book the planner is told about while it is held (GP.x).
   double held_box_height() const;
   /// BwH from the P1 check's or PS check's answer: its start point (P1 or PS) and the book front's Z.

@@ -58,6 +58,7 @@ std::string progress_to_yaml(const TaskProgress& p) {
   e << YAML::Key << "lower_next_right_y" << YAML::Value << p.lower_next_right_y;
   e << YAML::Key << "finished" << YAML::Value << p.finished;
   e << YAML::Key << "last_state" << YAML::Value << p.last_state;
+  e << YAML::Key << "hand_over_reason" << YAML::Value << p.hand_over_reason;
   e << YAML::Key << "moved" << YAML::Value << YAML::BeginSeq;
   for (const MovedBook& b : p.moved)
     e << YAML::Flow << YAML::BeginMap << YAML::Key << "index" << YAML::Value << b.index << YAML::Key << "width"
@@ -87,6 +88,8 @@ TaskProgress progress_from_yaml(const std::string& text, const std::string& sour
   p.lower_next_right_y = need<double>(n, "lower_next_right_y", source);
   p.finished = need<bool>(n, "finished", source);
   p.last_state = need<std::string>(n, "last_state", source);
+  // Absent before stop 25 (no book was handed over for any reason but its height then).
+  p.hand_over_reason = n["hand_over_reason"] ? need<std::string>(n, "hand_over_reason", source) : std::string();
   const YAML::Node moved = n["moved"];
   if (!moved || !moved.IsSequence()) throw std::runtime_error(source + ": missing list 'moved'");
   for (const YAML::Node& b : moved) {

@@ -31,7 +31,8 @@ struct MovedBook {
   double width = 0;           ///< from the gripper plates, m
   double gp_y = 0;            ///< grasp-frame Y of its GP (its right cover on the upper shelf), m
   double lower_right_y = 0;   ///< grasp-frame Y of its right cover on the lower shelf, m (handed over: NaN)
-  /// Too tall for the lower shelf: left on the holder and taken off it by the librarian (WAIT_BOOK_TAKEN).
+  /// Too tall for, or not placeable on, the lower shelf: left on the holder and taken off it by the librarian
+  /// (WAIT_BOOK_TAKEN).
   bool handed_over = false;
 };
 
@@ -45,6 +46,8 @@ struct TaskProgress {
   double book_width = 0;                  ///< current book's width (plates), m
   double lower_next_right_y = 0;          ///< right cover of the next book on the lower shelf, grasp Y
   bool finished = false;                  ///< the upper shelf is empty
+  /// Non-empty: why the lower shelf could not take the current book; it goes back onto the holder for the librarian.
+  std::string hand_over_reason;
   std::string last_state;                 ///< state-machine state when written
   std::vector<MovedBook> moved;           ///< the books moved, in order
 };

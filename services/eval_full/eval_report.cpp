@@ -120,8 +120,8 @@ void write_report(const std::string& dir, const EvalMetrics& m, const std::strin
   md << "| figure | this system | paper (Sec. 5) |\n|---|---|---|\n";
   md << "| grasp success | " << pct(m.grasp_successes, m.grasp_attempts) << " | 75 % (15/20) |\n";
   md << "| books through the whole cycle | " << pct(m.books_moved, m.books_targeted) << " | - |\n";
-  md << "| books too tall for the lower shelf (left on the holder for the librarian) | " << m.books_handed_over
-     << " | - |\n";
+  md << "| books left on the holder for the librarian: too tall for the lower shelf / not placeable there | "
+     << m.books_handed_over - m.books_handed_over_unplaceable << " / " << m.books_handed_over_unplaceable << " | - |\n";
   md << "| P1-P2 agreement (|dY| <= 15 mm, |dX| <= 20 mm) | " << pct(m.decisions_agreeing, m.decisions) << " | 80 % |\n";
   md << "| book width within 1 cm | " << pct(m.widths_within, m.widths) << " | 65 % |\n";
   md << "| book width error mean / max | " << f2(w.mean, "%.1f") << " / " << f2(w.max, "%.1f") << " mm | - |\n";

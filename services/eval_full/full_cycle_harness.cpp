@@ -401,7 +401,10 @@ struct FullCycleHarness::Impl {
     const std::string prev = status.state;
     const int prev_moved = status.books_moved;
     status = *m;
-    // sim_world's librarian took a book too tall for the lower shelf off the holder: its "taken" ended the cycle.
+    // sim_world's librarian took a book the coordinator left on the holder (too tall for the lower shelf, or the
+    // lower shelf could not take it: "... could not take it (...)" in WAIT_BOOK_TAKEN): its "taken" ended the cycle.
+    if (m->state == "WAIT_BOOK_TAKEN" && std::string(m->message).find("could not take it") != std::string::npos)
+      book(m->books_moved).handed_over_unplaceable = true;
     if (prev == "WAIT_BOOK_TAKEN" && m->books_moved > prev_moved) book(prev_moved).handed_over = true;
     if (m->books_moved > prev_moved) {
       for (int i = prev_moved; i < m->books_moved; ++i) {

@@ -78,9 +78,12 @@ struct BookRecord {
   int grasp_attempts = 0;            ///< CLOSE_GRIPPER entries for this book (from the shelf)
   int grasp_successes = 0;           ///< ... after which the book was in the gripper (physics)
   bool moved = false;                ///< completed the whole cycle (on the lower shelf)
-  /// Too tall for the lower shelf: the coordinator left it on the holder (WAIT_BOOK_TAKEN) and sim_world's
-  /// librarian took it out of the scene and said "taken".
+  /// Too tall for, or not placeable on, the lower shelf: the coordinator left it on the holder (WAIT_BOOK_TAKEN)
+  /// and sim_world's librarian took it out of the scene and said "taken".
   bool handed_over = false;
+  /// Handed over because the lower shelf could not take it (the coordinator's retries.hand_over_unplaceable: its
+  /// move there kept failing, or the shelf was full), not because it was too tall.
+  bool handed_over_unplaceable = false;
   /// SIM_GROUND_TRUTH place of the book when the coordinator left RELEASE_ON_HOLDER ("" = it never did):
   /// "holder" = the book was put on the holder; anything else = lost on the way or while placing.
   std::string place_after_holder_release;

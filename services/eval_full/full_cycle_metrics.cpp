@@ -98,6 +98,9 @@ std::string failure_reason(const FullCycleResult& r, int max_books) {
   }
   if (r.grasp_attempts > r.grasp_successes) return "GRASP_RETRIED: a grasp did not hold the book";
   for (const auto& b : r.books)
+    if (b.handed_over && b.handed_over_unplaceable)
+      return "HANDED_OVER: the lower shelf could not take a book; it went back to the holder for the librarian";
+  for (const auto& b : r.books)
     if (b.handed_over)
       return "HANDED_OVER: a book too tall for the lower shelf was left on the holder for the librarian";
   return "";
@@ -112,7 +115,10 @@ void accumulate(const SceneOutcome& o, int max_books, const MetricTolerances& to
   // A book counts as moved when the coordinator says so and the simulation's truth has it on the lower shelf.
   const int moved = books_on_lower_shelf(r);
   m->books_moved += std::min(moved, targeted > 0 ? targeted : moved);
-  for (const auto& b : r.books) m->books_handed_over += b.handed_over ? 1 : 0;
+  for (const auto& b : r.books) {
+    m->books_handed_over += b.handed_over ? 1 : 0;
+    m->books_handed_over_unplaceable += b.handed_over && b.handed_over_unplaceable ? 1 : 0;
+  }
   m->grasp_attempts += r.grasp_attempts;
   m->grasp_successes += r.grasp_successes;
   m->holder_releases += r.holder_releases;
@@ -199,6 +205,7 @@ std::string metrics_json(const EvalMetrics& m, const std::string& command) {
   j << "  \"books_moved\": " << m.books_moved << ",\n";
   j << "  \"books_moved_rate\": " << rate(m.books_moved, m.books_targeted) << ",\n";
   j << "  \"books_handed_over\": " << m.books_handed_over << ",\n";
+  j << "  \"books_handed_over_unplaceable\": " << m.books_handed_over_unplaceable << ",\n";
   j << "  \"grasp_attempts\": " << m.grasp_attempts << ",\n";
   j << "  \"grasp_successes\": " << m.grasp_successes << ",\n";
   j << "  \"grasp_success_rate\": " << rate(m.grasp_successes, m.grasp_attempts) << ",\n";

@@ -39,7 +39,8 @@ struct EvalMetrics {
   int scenes = 0;
   int books_targeted = 0;                    ///< books the cycle was asked to move (per scene: max_books or all)
   int books_moved = 0;
-  int books_handed_over = 0;  ///< too tall for the lower shelf: left on the holder for the librarian
+  int books_handed_over = 0;  ///< too tall for, or not placeable on, the lower shelf: left for the librarian
+  int books_handed_over_unplaceable = 0;  ///< ... of them because the lower shelf could not take them
   int grasp_attempts = 0;
   int grasp_successes = 0;
   int holder_releases = 0;                   ///< books the coordinator released on the holder

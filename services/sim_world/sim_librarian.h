@@ -1,7 +1,8 @@
 #pragma once
 /// @file
 /// The simulated librarian (not in the paper; simulation only): a book the coordinator leaves on the holder
-/// because it is too tall for the lower shelf (TASK_STATUS state WAIT_BOOK_TAKEN) is taken off it by a person.
+/// because it is too tall for the lower shelf, or because the lower shelf could not take it (TASK_STATUS state
+/// WAIT_BOOK_TAKEN), is taken off it by a person.
 /// This core decides when, in simulation time; sim_world's node moves the book out of the scene and publishes
 /// the person's USER_EVENT "taken". No LCM, no MuJoCo.
 

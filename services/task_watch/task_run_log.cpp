@@ -61,8 +61,9 @@ std::vector<std::string> TaskRunLog::on_status(const task_status_t& s) {
     ++books_moved_;
     book_start_utime_ = last_utime_;
     lines.push_back(t + "book " + std::to_string(b.index + 1) +
-                    (b.handed_over ? " taken off the holder by the librarian (too tall for the lower shelf)"
-                                   : " moved to the lower shelf") +
+                    (b.handed_over
+                         ? " taken off the holder by the librarian (too tall for, or not placeable on, the lower shelf)"
+                         : " moved to the lower shelf") +
                     " (cycle " + seconds(b.cycle_s) + ")");
   }
   if (s.failures > failures_count_) {
@@ -98,7 +99,7 @@ std::string TaskRunLog::summary() const {
   if (end_ == TaskEnd::kWaitingForLibrarian) o << "waiting for the librarian: " << last_message_ << "\n";
   const auto handed = std::count_if(moved_.begin(), moved_.end(), [](const MovedBook& b) { return b.handed_over; });
   o << "books moved (holder and back to the lower shelf): " << books_moved_ - handed;
-  if (handed > 0) o << "; handed to the librarian (too tall for the lower shelf): " << handed;
+  if (handed > 0) o << "; handed to the librarian (too tall for, or not placeable on, the lower shelf): " << handed;
   if (!moved_.empty()) {
     std::vector<double> c;
     for (const auto& b : moved_) c.push_back(b.cycle_s);

@@ -16,7 +16,8 @@ namespace bookgrasp {
 struct MovedBook {
   int index = 0;         ///< 0-based order in which it was taken
   double cycle_s = 0.0;  ///< message time from the start of its cycle to the report of it moved
-  bool handed_over = false;  ///< too tall for the lower shelf: taken off the holder by the librarian
+  bool handed_over =
+      false;  ///< too tall for, or not placeable on, the lower shelf: taken off the holder by the librarian
 };
 
 /// A failure the coordinator reported (TASK_STATUS.failures went up, or the task aborted).

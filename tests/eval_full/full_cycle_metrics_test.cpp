@@ -145,6 +145,19 @@ TEST(FullCycleMetrics, AHandedOverBookIsCountedApartAndNamedOnlyWhenNothingElseF
   EXPECT_EQ(m.books_moved, 1);
   EXPECT_EQ(m.books_handed_over, 1);
   EXPECT_NE(metrics_json(m, "cmd").find("\"books_handed_over\": 1"), std::string::npos);
+  EXPECT_EQ(m.books_handed_over_unplaceable, 0);
+  // The same book handed over because the lower shelf could not take it is named so, and counted apart.
+  {
+    SceneOutcome u = o;
+    u.result.books[0].handed_over_unplaceable = true;
+    EXPECT_EQ(failure_reason(u.result, 0),
+              "HANDED_OVER: the lower shelf could not take a book; it went back to the holder for the librarian");
+    EvalMetrics mu;
+    accumulate(u, 0, MetricTolerances{}, &mu);
+    EXPECT_EQ(mu.books_handed_over, 1);
+    EXPECT_EQ(mu.books_handed_over_unplaceable, 1);
+    EXPECT_NE(metrics_json(mu, "cmd").find("\"books_handed_over_unplaceable\": 1"), std::string::npos);
+  }
   // A book that fell is still named first.
   o.result.final_truth.books[1].place = "other";
   EXPECT_EQ(failure_reason(o.result, 0), "BOOK_NOT_ON_LOWER_SHELF at the end: the book is other");
