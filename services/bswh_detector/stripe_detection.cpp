@@ -33,6 +33,8 @@ StripeDetectionParams StripeDetectionParams::from_config(const Config& cfg) {
   if (cfg.has("min_band_fill")) p.min_band_fill = cfg.get_double("min_band_fill", 0.0, 1.0);
   if (cfg.has("expected_row_px")) p.expected_row_px = cfg.get_double("expected_row_px", -1.0, 10000.0);
   if (cfg.has("max_row_offset_px")) p.max_row_offset_px = cfg.get_double("max_row_offset_px", 1.0, 1e9);
+  if (cfg.has("background_kernel_width_px"))
+    p.background_kernel_width_px = cfg.get_int("background_kernel_width_px", 0, 1024);
   return p;
 }
 
@@ -98,7 +100,8 @@ StripeDetection detect_stripe(const cv::Mat& image, const StripeDetectionParams&
   cv::Mat small;
   cv::resize(smooth, small, cv::Size(std::max(1, v.cols / scale), std::max(1, v.rows / scale)), 0, 0, cv::INTER_AREA);
   const int k = std::max(3, (p.background_kernel_px / scale) | 1);
-  cv::morphologyEx(small, small, cv::MORPH_CLOSE, cv::getStructuringElement(cv::MORPH_RECT, cv::Size(k, k)));
+  const int kw = p.background_kernel_width_px > 0 ? std::max(1, (p.background_kernel_width_px / scale) | 1) : k;
+  cv::morphologyEx(small, small, cv::MORPH_CLOSE, cv::getStructuringElement(cv::MORPH_RECT, cv::Size(kw, k)));
   cv::blur(small, small, cv::Size(3, 3));
   cv::Mat background;
   cv::resize(small, background, v.size(), 0, 0, cv::INTER_LINEAR);

@@ -19,6 +19,10 @@ struct StripeDetectionParams {
   double blur_sigma_px = 1.2;     ///< Gaussian pre-smoothing against noise
   int background_scale = 8;       ///< background estimated on an image this many times smaller
   int background_kernel_px = 64;  ///< closing size (full-resolution px) removing dark structures for the background
+  /// Width of that closing (full-resolution px; 0 = background_kernel_px, a square). Narrow: only dark structures
+  /// thinner than background_kernel_px vertically (the stripe, a cover's top) leave the background; tall ones (a
+  /// standing book's shadow on the rear board, a dark cover) stay in it and are not taken for the stripe.
+  int background_kernel_width_px = 0;
   double dark_ratio = 0.5;        ///< a pixel is stripe if value < dark_ratio * local background ...
   int max_dark_value = 90;        ///< ... and value (max of R, G, B) < this
   int min_length_px = 40;         ///< shortest visible stripe segment

@@ -91,6 +91,36 @@ TEST(StripeDetection, ThickStripeDarkCoverNextToIt) {
   expect_end_within(s, "thick_darkcover", 2.0);
 }
 
+// A standing book's shadow on the rear board right of it (far_cart seed 1014: lit board ~160, the shadow ~52, the
+// stripe ~5 grey levels): a tall dark band touching the book, crossing the stripe. It is darker than half the lit
+// board, so with a square background closing it was taken for stripe, and the dark region was 240 px "thick". The
+// shipped narrow closing (stripe.background_kernel_width_px) keeps tall dark structures in the background.
+test::SynthScene book_shadow_scene() {
+  test::SynthScene s = test::default_scene();
+  test::SynthTruth truth;
+  test::render_scene(s, &truth);
+  const double x0 = truth.stripe_end.x;  // on the rear board, from the book's right cover outwards
+  s.shadows.push_back({{{x0, 110}, {x0 + 55, 110}, {x0 + 55, 430}, {x0, 430}}, 0.33, 1.5});
+  return s;
+}
+
+TEST(StripeDetection, ABooksTallShadowOnTheRearBoardIsNotTheStripe) {
+  ASSERT_GT(shipped_params().background_kernel_width_px, 0) << "bswh_detector.yaml ships the narrow closing";
+  expect_end_within(book_shadow_scene(), "book_shadow", 2.0);
+}
+
+TEST(StripeDetection, WithASquareBackgroundClosingTheBooksShadowIsTakenForTheStripe) {
+  // The earlier behaviour, documenting what the key is for and that the test above can fail.
+  StripeDetectionParams p = params();
+  p.background_kernel_width_px = 0;
+  test::SynthTruth truth;
+  const cv::Mat img = test::render_scene(book_shadow_scene(), &truth);
+  const StripeDetection d = detect_stripe(img, p);
+  const bool right = d.end_found && std::hypot(d.end.x - truth.stripe_end.x, d.end.y - truth.stripe_end.y) < 2.0;
+  EXPECT_FALSE(right) << "found " << d.found << " end " << d.end_found << " (" << d.end.x << ", " << d.end.y
+                      << "): " << d.failure_reason;
+}
+
 TEST(StripeDetection, RandomScenesWithin2px) {
   cv::RNG rng(20240611);
   for (int i = 0; i < 20; ++i) {
@@ -204,6 +234,7 @@ TEST(StripeDetectionRendered, WithoutTheRobustnessKeysTheShadowBesideTheFingerWi
   p.reject_touching_bottom = false;
   p.min_band_fill = 0.0;
   p.expected_row_px = -1;
+  p.background_kernel_width_px = 0;  // the square closing of that time (keeps the panel's shadow "dark")
   const StripeDetection d = detect_stripe(load_rendered("hand_eval_seed1_station_a.png"), p);
   ASSERT_TRUE(d.end_found);
   EXPECT_GT(d.end.y, 440.0) << "the end is expected in the finger rows without the keys";
