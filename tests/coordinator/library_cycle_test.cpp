@@ -53,6 +53,28 @@ bool done_or_aborted(const LibraryCycle& c) {
   return c.state() == CycleState::kDone || c.state() == CycleState::kAborted;
 }
 
+// Runs the cycle to DONE or ABORTED; returns TASK_STATUS's message of its last wait for the librarian ("" = none).
+std::string run_noting_the_librarian_wait(FakeLibrary& w, LibraryCycle& cycle) {
+  std::string waiting_message;
+  w.run(cycle, [&] {
+    if (cycle.state() == CycleState::kWaitBookTaken) waiting_message = cycle.status().message;
+    return done_or_aborted(cycle);
+  });
+  return waiting_message;
+}
+
+// The ids of books, in order (books placed somewhere with the TCP at their release, or books alone).
+std::vector<int> ids(const std::vector<std::pair<FakeBook, Eigen::Isometry3d>>& placed) {
+  std::vector<int> out;
+  for (const auto& p : placed) out.push_back(p.first.id);
+  return out;
+}
+std::vector<int> ids(const std::vector<FakeBook>& books) {
+  std::vector<int> out;
+  for (const auto& b : books) out.push_back(b.id);
+  return out;
+}
+
 TEST(LibraryCycle, ThreeBooksWholeCycleEveryTransitionAndPlacements) {
   FakeLibrary w(three_books());
   LibraryCycle cycle(settings(), std::nullopt);
@@ -217,17 +239,10 @@ TEST(LibraryCycle, ABookTooTallForTheLowerShelfStaysOnTheHolderForTheLibrarian) 
   ASSERT_NEAR(bookgrasp::lower_shelf_max_book_height(cs.geometry), 0.274, 1e-9);
   FakeLibrary w({{0, 0.025, 0.29, 0.300}, {1, 0.020, 0.18, 0.273}, {2, 0.030, 0.27, 0.251}});
   LibraryCycle cycle(cs, std::nullopt);
-  std::string waiting_message;
-  w.run(cycle, [&] {
-    if (cycle.state() == CycleState::kWaitBookTaken) waiting_message = cycle.status().message;
-    return done_or_aborted(cycle);
-  });
+  const std::string waiting_message = run_noting_the_librarian_wait(w, cycle);
   ASSERT_EQ(cycle.state(), CycleState::kDone) << cycle.status().message;
-  ASSERT_EQ(w.taken_by_librarian.size(), 1u);
-  EXPECT_EQ(w.taken_by_librarian[0].id, 0);
-  ASSERT_EQ(w.lower.size(), 2u);  // the 0.27 m book fits
-  EXPECT_EQ(w.lower[0].first.id, 1);
-  EXPECT_EQ(w.lower[1].first.id, 2);
+  EXPECT_EQ(ids(w.taken_by_librarian), (std::vector<int>{0}));
+  EXPECT_EQ(ids(w.lower), (std::vector<int>{1, 2}));  // the 0.27 m book fits
   EXPECT_EQ(count(w.states, "WAIT_BOOK_TAKEN"), 1);
   EXPECT_EQ(w.holder_grasps.size(), 2u) << "the tall book is never taken off the holder by the robot";
   EXPECT_NE(waiting_message.find("290.0 mm tall"), std::string::npos) << waiting_message;
@@ -474,17 +489,10 @@ TEST(LibraryCycle, ABookTheLowerShelfCannotTakeGoesBackOnTheHolderForTheLibraria
   w.plan_failures["MOVE_TO_LOWER_SHELF"] = 3;  // the first book's try and both retries
   const CycleSettings cs = settings();
   LibraryCycle cycle(cs, std::nullopt);
-  std::string waiting_message;
-  w.run(cycle, [&] {
-    if (cycle.state() == CycleState::kWaitBookTaken) waiting_message = cycle.status().message;
-    return done_or_aborted(cycle);
-  });
+  const std::string waiting_message = run_noting_the_librarian_wait(w, cycle);
   ASSERT_EQ(cycle.state(), CycleState::kDone) << cycle.status().message;
-  ASSERT_EQ(w.taken_by_librarian.size(), 1u);
-  EXPECT_EQ(w.taken_by_librarian[0].id, 0);
-  ASSERT_EQ(w.lower.size(), 2u);
-  EXPECT_EQ(w.lower[0].first.id, 1);
-  EXPECT_EQ(w.lower[1].first.id, 2);
+  EXPECT_EQ(ids(w.taken_by_librarian), (std::vector<int>{0}));
+  EXPECT_EQ(ids(w.lower), (std::vector<int>{1, 2}));
   ASSERT_EQ(cycle.progress().moved.size(), 3u);
   EXPECT_TRUE(cycle.progress().moved[0].handed_over);
   EXPECT_TRUE(std::isnan(cycle.progress().moved[0].lower_right_y));
@@ -521,17 +529,10 @@ TEST(LibraryCycle, BooksAFullLowerShelfCannotTakeGoToTheLibrarian) {
   // Room for the first book (25 mm) only: the second (20 mm) would end 5 mm beyond the left end.
   cs.geometry.lower_left_y = cs.geometry.lower_first_right_y - 0.025 - cs.geometry.lower_gap - 0.015;
   LibraryCycle cycle(cs, std::nullopt);
-  std::string waiting_message;
-  w.run(cycle, [&] {
-    if (cycle.state() == CycleState::kWaitBookTaken) waiting_message = cycle.status().message;
-    return done_or_aborted(cycle);
-  });
+  const std::string waiting_message = run_noting_the_librarian_wait(w, cycle);
   ASSERT_EQ(cycle.state(), CycleState::kDone) << cycle.status().message;
-  ASSERT_EQ(w.lower.size(), 1u);
-  EXPECT_EQ(w.lower[0].first.id, 0);
-  ASSERT_EQ(w.taken_by_librarian.size(), 2u);
-  EXPECT_EQ(w.taken_by_librarian[0].id, 1);
-  EXPECT_EQ(w.taken_by_librarian[1].id, 2);
+  EXPECT_EQ(ids(w.lower), (std::vector<int>{0}));
+  EXPECT_EQ(ids(w.taken_by_librarian), (std::vector<int>{1, 2}));
   EXPECT_NE(waiting_message.find("the lower shelf is full"), std::string::npos) << waiting_message;
   EXPECT_EQ(cycle.progress().failures, 0) << "a full shelf is not a failure";
 }
@@ -552,11 +553,8 @@ TEST(LibraryCycle, ACoordinatorRestartedOnTheWayBackToTheHolderHandsTheBookOver)
     LibraryCycle second(settings(), progress);
     w.run(second, [&] { return done_or_aborted(second); });
     ASSERT_EQ(second.state(), CycleState::kDone) << second.status().message;
-    ASSERT_EQ(w.taken_by_librarian.size(), 1u);
-    EXPECT_EQ(w.taken_by_librarian[0].id, 0);
-    ASSERT_EQ(w.lower.size(), 2u);
-    EXPECT_EQ(w.lower[0].first.id, 1);
-    EXPECT_EQ(w.lower[1].first.id, 2);
+    EXPECT_EQ(ids(w.taken_by_librarian), (std::vector<int>{0}));
+    EXPECT_EQ(ids(w.lower), (std::vector<int>{1, 2}));
     EXPECT_EQ(count(w.states, "WAIT_USER"), 3) << "the user is not asked again";
   }
 }
