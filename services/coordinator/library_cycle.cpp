@@ -885,15 +885,13 @@ void LibraryCycle::fail(const std::string& reason) {
     enter(inside ? CycleState::kBackOut : CycleState::kPark);
     return;
   }
-  if (step_retries_ >= s_.max_step_retries && state_ == CycleState::kMoveToLowerShelf) {
-    return_to_holder(cycle_state_name(state_) + " failed " + std::to_string(step_retries_ + 1) +
-                     " times (retries.max_step_retries), last: " + reason);
-    return;
-  }
   if (step_retries_ >= s_.max_step_retries) {
-    abort(cycle_state_name(state_) + " failed " + std::to_string(step_retries_ + 1) +
-          " times (retries.max_step_retries), last: " + reason + "; the book is on/in the " +
-          book_place_name(progress_.place));
+    const std::string why = cycle_state_name(state_) + " failed " + std::to_string(step_retries_ + 1) +
+                            " times (retries.max_step_retries), last: " + reason;
+    if (state_ == CycleState::kMoveToLowerShelf)
+      return_to_holder(why);  // the lower shelf cannot take the book
+    else
+      abort(why + "; the book is on/in the " + book_place_name(progress_.place));
     return;
   }
   step_retries_ += 1;
