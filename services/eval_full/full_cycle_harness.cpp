@@ -156,6 +156,37 @@ struct FullCycleHarness::Impl {
   bool in_extract = false;
   /// Where the book sat in the TCP frame when the plates had closed (the coordinator left CLOSE_GRIPPER).
   std::optional<Eigen::Vector3d> book_in_tcp_at_close;
+  /// Every other book on the upper shelf when the plates had closed: its centre in the TCP frame and in base.
+  struct OtherBookAtClose {
+    int id = -1;
+    Eigen::Vector3d in_tcp, in_base;
+  };
+  std::vector<OtherBookAtClose> others_at_close;
+  /// Books on the upper shelf other than `target_id`, where they sit now (TCP frame and base).
+  std::vector<OtherBookAtClose> other_books_now(const ground_truth_t& truth, int target_id) const {
+    std::vector<OtherBookAtClose> out;
+    const auto& model = sim->world().model();
+    const int site = mj_name2id(model.model(), mjOBJ_SITE, "gripper");
+    for (const auto& tb : truth.books) {
+      if (tb.id == target_id) continue;
+      const int body = mj_name2id(model.model(), mjOBJ_BODY, ("book_" + std::to_string(tb.id)).c_str());
+      if (body < 0 || site < 0) continue;
+      const Eigen::Vector3d c = body_pose(model.data(), body).translation();
+      out.push_back({tb.id, site_pose(model.data(), site).inverse() * c, c});
+    }
+    return out;
+  }
+  /// Ids of the books in `others_at_close` that came out with the TCP: they moved more than 5 cm in base since the
+  /// close and sit within 1 cm of where they sat in the TCP frame (lifted together with the target).
+  std::vector<int> carried_along(const ground_truth_t& truth, int target_id) const {
+    std::vector<int> ids;
+    const auto now = other_books_now(truth, target_id);
+    for (const auto& c : others_at_close)
+      for (const auto& n : now)
+        if (n.id == c.id && (n.in_base - c.in_base).norm() > 0.05 && (n.in_tcp - c.in_tcp).norm() < 0.01)
+          ids.push_back(c.id);
+    return ids;
+  }
   /// The truth book `id`'s centre in the TCP frame (nullopt if there is no such book).
   std::optional<Eigen::Vector3d> book_in_tcp(int id) const {
     const auto& model = sim->world().model();
@@ -462,7 +493,14 @@ struct FullCycleHarness::Impl {
       ++res.grasp_attempts;
       in_extract = true;
     }
-    if (in_extract && prev == "CLOSE_GRIPPER") book_in_tcp_at_close = book_in_tcp(book(m->current_book).truth_id);
+    if (in_extract && prev == "CLOSE_GRIPPER") {
+      const int id = book(m->current_book).truth_id;
+      book_in_tcp_at_close = book_in_tcp(id);
+      others_at_close.clear();
+      for (const auto& c : other_books_now(now_truth, id))
+        for (const auto& tb : now_truth.books)
+          if (tb.id == c.id && tb.place == "upper_shelf") others_at_close.push_back(c);
+    }
     if (in_extract && prev == "EXTRACT") {
       in_extract = false;
       BookRecord& b = book(m->current_book);
@@ -474,11 +512,17 @@ struct FullCycleHarness::Impl {
       const bool carried = tb && tb->place == "other" && book_in_tcp_at_close && now_in_tcp &&
                            (*now_in_tcp - *book_in_tcp_at_close).norm() < 0.01;
       const bool held = tb && (tb->place == "gripper" || carried);
-      if (held) {
+      // A grasp that brings other books out with the target is not a success: the task takes one book at a time.
+      const std::vector<int> along = carried_along(now_truth, b.truth_id);
+      b.carried_along.insert(b.carried_along.end(), along.begin(), along.end());
+      std::string along_text;
+      for (int id : along) along_text += (along_text.empty() ? "" : ", ") + std::to_string(id);
+      if (!along.empty()) trace("GRASP TOOK MORE: book id(s) " + along_text + " came out with the TCP as well");
+      if (held && along.empty()) {
         ++b.grasp_successes;
         ++res.grasp_successes;
       }
-      trace(std::string("GRASP ") + (held ? "held" : "FAILED") + ": book id " + std::to_string(b.truth_id) + " is " +
+      trace(std::string("GRASP ") + (held ? (along.empty() ? "held" : "held with other books: FAILED") : "FAILED") + ": book id " + std::to_string(b.truth_id) + " is " +
             (tb ? tb->place : std::string("unknown")) +
             (carried ? " (carried: it moved with the TCP since the close, one plate's contact off this instant)" : ""));
     } else if (in_extract && m->state != "EXTRACT" && m->state != "CLOSE_GRIPPER") {

@@ -76,7 +76,10 @@ struct BookRecord {
   double true_width_m = 0;
   double measured_width_m = -1;      ///< arbiter BOOK_WIDTH (-1 = none)
   int grasp_attempts = 0;            ///< CLOSE_GRIPPER entries for this book (from the shelf)
-  int grasp_successes = 0;           ///< ... after which the book was in the gripper (physics)
+  int grasp_successes = 0;           ///< ... after which the book, and no other, was in the gripper (physics)
+  /// Ids of other books that came out of the upper shelf with the TCP in this book's grasps (a double lift:
+  /// moved > 5 cm since the close, within 1 cm of where they sat in the TCP frame when EXTRACT ended).
+  std::vector<int> carried_along;
   bool moved = false;                ///< completed the whole cycle (on the lower shelf)
   /// Too tall for, or not placeable on, the lower shelf: the coordinator left it on the holder (WAIT_BOOK_TAKEN)
   /// and sim_world's librarian took it out of the scene and said "taken".

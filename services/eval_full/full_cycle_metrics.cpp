@@ -42,6 +42,16 @@ std::string final_place(const FullCycleResult& r, const BookRecord& b) {
   return "unknown";
 }
 
+std::vector<int> untargeted_books_off_the_upper_shelf(const FullCycleResult& r) {
+  std::vector<int> ids;
+  for (const auto& t : r.final_truth.books) {
+    const bool targeted =
+        std::any_of(r.books.begin(), r.books.end(), [&](const BookRecord& b) { return b.truth_id == t.id; });
+    if (!targeted && t.place != "upper_shelf") ids.push_back(t.id);
+  }
+  return ids;
+}
+
 int books_on_lower_shelf(const FullCycleResult& r) {
   int n = 0;
   for (const auto& b : r.books) n += b.moved && final_place(r, b) == "lower_shelf" ? 1 : 0;
@@ -50,6 +60,10 @@ int books_on_lower_shelf(const FullCycleResult& r) {
 
 std::string failure_reason(const FullCycleResult& r, int max_books) {
   if (r.end == "ERROR") return "ERROR: " + r.message;
+  for (const auto& b : r.books)
+    if (!b.carried_along.empty())
+      return "DOUBLE_LIFT: a grasp took " + std::to_string(b.carried_along.size()) +
+             " other book(s) out of the shelf with the target";
   for (const auto& b : r.books)
     if (!b.place_after_holder_release.empty() && b.place_after_holder_release != "holder")
       return "BOOK_NOT_ON_HOLDER after RELEASE_ON_HOLDER: the book is " + b.place_after_holder_release +
@@ -61,6 +75,9 @@ std::string failure_reason(const FullCycleResult& r, int max_books) {
     if (b.moved && !b.handed_over && place != "lower_shelf")
       return "BOOK_NOT_ON_LOWER_SHELF at the end: the book is " + place;
   }
+  if (const auto off = untargeted_books_off_the_upper_shelf(r); !off.empty())
+    return "OTHER_BOOK_OFF_THE_UPPER_SHELF at the end: " + std::to_string(off.size()) +
+           " book(s) the task never took left the upper shelf";
   if (r.end == "ABORTED") {
     // "aborted in STATE: book 0: 3 attempts failed (...), last: <cause>": class = state + cause.
     const auto in = r.message.find("aborted in ");
@@ -119,6 +136,8 @@ void accumulate(const SceneOutcome& o, int max_books, const MetricTolerances& to
     m->books_handed_over += b.handed_over ? 1 : 0;
     m->books_handed_over_unplaceable += b.handed_over && b.handed_over_unplaceable ? 1 : 0;
   }
+  for (const auto& b : r.books) m->books_carried_along += static_cast<int>(b.carried_along.size());
+  m->untargeted_books_off_the_upper_shelf += static_cast<int>(untargeted_books_off_the_upper_shelf(r).size());
   m->grasp_attempts += r.grasp_attempts;
   m->grasp_successes += r.grasp_successes;
   m->holder_releases += r.holder_releases;
@@ -209,6 +228,8 @@ std::string metrics_json(const EvalMetrics& m, const std::string& command) {
   j << "  \"grasp_attempts\": " << m.grasp_attempts << ",\n";
   j << "  \"grasp_successes\": " << m.grasp_successes << ",\n";
   j << "  \"grasp_success_rate\": " << rate(m.grasp_successes, m.grasp_attempts) << ",\n";
+  j << "  \"books_carried_along\": " << m.books_carried_along << ",\n";
+  j << "  \"untargeted_books_off_the_upper_shelf\": " << m.untargeted_books_off_the_upper_shelf << ",\n";
   j << "  \"holder_releases\": " << m.holder_releases << ",\n";
   j << "  \"holder_placed_rate\": " << rate(m.holder_placed, m.holder_releases) << ",\n";
   j << "  \"holder_standing_rate\": " << rate(m.holder_standing, m.holder_retreats) << ",\n";

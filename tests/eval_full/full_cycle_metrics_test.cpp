@@ -176,15 +176,21 @@ TEST(FullCycleMetrics, FailureReasons) {
   EXPECT_EQ(failure_reason(r, 1), "ABORTED in SERVO_STRIPE: stripe servo ended TIMEOUT: no convergence");
   r.end = "DONE";
   r.message.clear();
-  r.final_truth.books = {truth_book("lower_shelf"), truth_book("other")};
+  BookRecord first, second;
+  first.truth_id = 0;
+  second.truth_id = 1;
+  r.books = {first, second};
+  r.final_truth.books = {truth_book("lower_shelf", 0), truth_book("other", 1)};
   EXPECT_EQ(failure_reason(r, 0), "DONE with 1 book(s) neither on a shelf");
-  r.final_truth.books = {truth_book("lower_shelf"), truth_book("lower_shelf")};
+  r.final_truth.books = {truth_book("lower_shelf", 0), truth_book("lower_shelf", 1)};
   EXPECT_EQ(failure_reason(r, 0), "");
   // A book the coordinator released on the holder that the truth does not place there names the scene's
   // failure, before the abort it leads to (the grasp from the holder closing on nothing).
   r.end = "ABORTED";
   r.message = "aborted in MOVE_TO_HOLDER_PRE_GRASP: book 0: last: plan failed";
+  r.final_truth.books = {truth_book("other", 0), truth_book("upper_shelf", 1)};
   BookRecord lost;
+  lost.truth_id = 0;
   lost.grasp_attempts = lost.grasp_successes = 1;
   lost.place_after_holder_release = "other";
   r.books = {lost};
@@ -200,6 +206,42 @@ TEST(FullCycleMetrics, FailureReasons) {
   EXPECT_EQ(failure_reason(r, 1), "BOOK_NOT_STANDING_ON_HOLDER after RETREAT_FROM_HOLDER");
   r.books[0].standing_on_holder = 1;
   EXPECT_EQ(failure_reason(r, 1), "ABORTED in MOVE_TO_HOLDER_PRE_GRASP: plan failed");
+}
+
+TEST(FullCycleMetrics, AGraspThatTookAnotherBookAlongIsADoubleLift) {
+  // Book 0's grasp took book 2 out of the shelf with it: the grasp is no success, the scene's failure is named
+  // DOUBLE_LIFT before anything that follows from it, and book 2 (never targeted) is off the upper shelf.
+  SceneOutcome o = done_scene(7);
+  FullCycleResult& r = o.result;
+  r.books.pop_back();  // books 0 and 1 only
+  r.grasp_attempts = 2;
+  r.grasp_successes = 1;  // the harness counted book 0's grasp as failed
+  r.books[0].grasp_successes = 0;
+  r.books[0].carried_along = {2};
+  r.final_truth.books.push_back(truth_book("lower_shelf", 2));
+  EXPECT_EQ(untargeted_books_off_the_upper_shelf(r), std::vector<int>{2});
+  EXPECT_EQ(failure_reason(r, 0), "DOUBLE_LIFT: a grasp took 1 other book(s) out of the shelf with the target");
+  EvalMetrics m;
+  accumulate(o, 0, MetricTolerances{}, &m);
+  EXPECT_EQ(m.books_carried_along, 1);
+  EXPECT_EQ(m.untargeted_books_off_the_upper_shelf, 1);
+  EXPECT_DOUBLE_EQ(static_cast<double>(m.grasp_successes) / m.grasp_attempts, 0.5);
+  EXPECT_EQ(m.widths, 1);  // book 0's plate distance spanned two books: not a width measurement
+  const std::string json = metrics_json(m, "cmd");
+  EXPECT_NE(json.find("\"books_carried_along\": 1"), std::string::npos);
+  EXPECT_NE(json.find("\"untargeted_books_off_the_upper_shelf\": 1"), std::string::npos);
+
+  // Without the lift, a book the task never took that left the upper shelf (pushed or knocked off) is named too,
+  // in a first-book run as well as in a whole-shelf one.
+  r.books[0].carried_along.clear();
+  r.books[0].grasp_successes = 1;
+  r.grasp_successes = 2;
+  r.final_truth.books[2].place = "other";
+  r.end = "BOOKS";  // a first-book run: it stopped after its book
+  EXPECT_EQ(failure_reason(r, 1),
+            "OTHER_BOOK_OFF_THE_UPPER_SHELF at the end: 1 book(s) the task never took left the upper shelf");
+  r.final_truth.books[2].place = "upper_shelf";
+  EXPECT_EQ(failure_reason(r, 1), "");
 }
 
 TEST(FullCycleMetrics, JsonCarriesTheRequiredKeys) {
