@@ -144,6 +144,8 @@ void CoordinatorNode::on_servo_status(const servo_status_t& msg) {
   e.mode = msg.mode;
   e.state = msg.state;
   e.front_width_m = msg.front_width_m;
+  e.neighbour_offset_m = msg.neighbour_offset_m;
+  e.neighbour_width_m = msg.neighbour_width_m;
   e.message = msg.message;
   send(cycle_.on_servo(e), msg.utime);
   after_event(msg.utime);

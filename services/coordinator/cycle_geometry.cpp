@@ -42,6 +42,9 @@ CycleGeometry CycleGeometry::from_config(const Config& c) {
   g.grasp_offset_y = c.get_double("grasp.offset_y_m", -0.1, 0.1);
   g.insertion_depth = c.get_double("grasp.insertion_depth_m", 0.0, 0.2);
   g.width_left_clearance = c.get_double("grasp.width_left_clearance_m", 0.0, 0.05);
+  g.left_plate_on_neighbour = c.get<bool>("grasp.left_plate_on_neighbour");
+  g.plate_thickness = c.get_double("grasp.plate_thickness_m", 0.0, 0.05);
+  g.left_plate_min_clearance = c.get_double("grasp.left_plate_min_clearance_m", 0.0, 0.05);
   g.pre_grasp_distance = c.get_double("grasp.pre_grasp_distance_m", 0.01, 0.5);
   g.deep_front_z = c.get_double("grasp.deep_front_z_m", -0.2, 0.36);
   g.extract_lift = c.get_double("grasp.extract_lift_m", 0.0, 0.5);
@@ -140,11 +143,20 @@ Eigen::Isometry3d grasp_pose(const Eigen::Isometry3d& gp, const CycleGeometry& g
   return move_along_own_axes(gp, Eigen::Vector3d(g.grasp_offset_x, g.grasp_offset_y, g.insertion_depth));
 }
 
-PlateOpening plate_opening(double front_width, double open_width, const CycleGeometry& g) {
+PlateOpening plate_opening(const ForeEdges& edges, double open_width, const CycleGeometry& g) {
   const PlateOpening full{open_width, g.grasp_offset_y};
-  if (!(g.width_left_clearance > 0) || !std::isfinite(front_width) || !(front_width > 0)) return full;
+  const auto measured = [](double v) { return std::isfinite(v) && v > 0; };
+  if (!measured(edges.front_width)) return full;
+  double left = 0;  // the left plate's inner face, left of GP
+  if (g.left_plate_on_neighbour && measured(edges.neighbour_offset) && measured(edges.neighbour_width))
+    left = std::max(edges.neighbour_offset + 0.5 * edges.neighbour_width - 0.5 * g.plate_thickness,
+                    edges.front_width + g.left_plate_min_clearance);
+  else if (g.width_left_clearance > 0)
+    left = edges.front_width + g.width_left_clearance;
+  else
+    return full;
   const double right = 0.5 * open_width + g.grasp_offset_y;  // right plate's inner face, right of GP
-  const double width = right + front_width + g.width_left_clearance;
+  const double width = right + left;
   if (width >= open_width) return full;
   return {width, right - 0.5 * width};
 }

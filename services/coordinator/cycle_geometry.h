@@ -42,6 +42,14 @@ struct CycleGeometry {
   /// beyond the book on its left (the right plate stays where grasp_offset_y and the full opening put it), so the
   /// open left plate lands on the neighbour next to the book, not on the one after it. 0 = always the full opening.
   double width_left_clearance = 0.0;
+  /// Not in the paper: with the next fore-edge to the left measured by the corner servo, the open left plate's
+  /// middle goes to that book's middle, so the plate pushes the neighbour back square instead of landing on a seam
+  /// or on the book after it (which then stood between the plates: a double lift). Takes precedence over
+  /// width_left_clearance; without a measured neighbour that rule (or the full opening) applies.
+  bool left_plate_on_neighbour = false;
+  double plate_thickness = 0.010;  ///< a plate's thickness across the books (Y)
+  /// The left plate's inner face stays at least this far left of the book's measured fore-edge.
+  double left_plate_min_clearance = 0.003;
   double pre_grasp_distance = 0.10; ///< pre-grasp pose this far in front of GP along -Z
   /// Deepest GP (grasp Z) the pre-grasp and the extraction's end are measured from: a deeper front (books
   /// pushed back by an earlier grasp's left plate) gets the pre-grasp and the extraction's end a front at this
@@ -113,11 +121,20 @@ struct PlateOpening {
   double offset_y = 0.0;  ///< TCP right (+) of GP along Y (replaces CycleGeometry::grasp_offset_y)
 };
 
-/// The plates' opening for a fore-edge `front_width` wide (<= 0 or not finite: not measured) with the gripper's
-/// full opening `open_width`. The right plate's inner face stays open_width / 2 + grasp_offset_y right of GP; with
-/// width_left_clearance > 0 and a measured width the left one comes to front_width + width_left_clearance left of
-/// GP, unless that needs more than the full opening. Otherwise: {open_width, grasp_offset_y}.
-PlateOpening plate_opening(double front_width, double open_width, const CycleGeometry& g);
+/// What the corner servo measured across the fore-edges at R's depth (m; <= 0 or not finite: not measured).
+struct ForeEdges {
+  double front_width = 0.0;       ///< the target's fore-edge width
+  double neighbour_offset = 0.0;  ///< how far left of R the next fore-edge's right edge lies
+  double neighbour_width = 0.0;   ///< the next fore-edge's width
+};
+
+/// The plates' opening for the fore-edges `edges` with the gripper's full opening `open_width`. The right plate's
+/// inner face stays open_width / 2 + grasp_offset_y right of GP. The left one's inner face goes, with
+/// left_plate_on_neighbour and the neighbour measured, to the neighbour's middle less half a plate (but at least
+/// front_width + left_plate_min_clearance left of GP); else, with width_left_clearance > 0 and a measured width, to
+/// front_width + width_left_clearance left of GP; never wider than the full opening. Otherwise: {open_width,
+/// grasp_offset_y}.
+PlateOpening plate_opening(const ForeEdges& edges, double open_width, const CycleGeometry& g);
 /// Book height above its support at the TCP: GP.x (top above the upper shelf) plus the X offset.
 double tcp_height_on_book(const Eigen::Vector3d& gp_grasp, const CycleGeometry& g);
 /// TCP height above the book's bottom for the grasp from the holder: `tcp_height` (the grasp from the shelf)

@@ -361,7 +361,7 @@ void LibraryCycle::start_linear(std::vector<Eigen::Isometry3d> waypoints, double
 }
 
 PlateOpening LibraryCycle::grasp_opening() const {
-  return plate_opening(front_width_, s_.gripper_open_width, s_.geometry);
+  return plate_opening(fore_edges_, s_.gripper_open_width, s_.geometry);
 }
 
 CycleGeometry LibraryCycle::grasp_geometry() const {
@@ -712,7 +712,7 @@ void LibraryCycle::enter(CycleState s) {
       r.kind = CycleRequest::Kind::kServo;
       r.id = next_id();
       servo_request_ = r.id;
-      front_width_ = 0.0;
+      fore_edges_ = ForeEdges{};
       r.servo_mode = kServoBookCorner;
       r.pose = arm_ ? arm_->end_effector : bwh_start_pose(cart_frame(), bwh_start_, g);
       r.rank = rank_;
@@ -1151,8 +1151,7 @@ std::vector<CycleRequest> LibraryCycle::on_servo(const ServoEvent& e) {
     else
       fail("stripe servo ended " + servo_state_name(e.state) + (e.message.empty() ? "" : ": " + e.message));
   } else if (state_ == CycleState::kServoBook && e.request_id == servo_request_ && terminal) {
-    if (e.state == kServoConverged && std::isfinite(e.front_width_m) && e.front_width_m > 0)
-      front_width_ = e.front_width_m;
+    if (e.state == kServoConverged) fore_edges_ = {e.front_width_m, e.neighbour_offset_m, e.neighbour_width_m};
     // Converged or not, the arbiter decides (a failed BwH servo is its NO_GRASP).
     succeed(CycleState::kWaitDecision);
   }

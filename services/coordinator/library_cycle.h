@@ -134,6 +134,8 @@ struct ServoEvent {
   int mode = 0;   ///< servo_request_t mode
   int state = 0;  ///< servo_status_t state
   double front_width_m = 0;  ///< BOOK_CORNER CONVERGED: the fore-edge's width from the servo (0 = not measured)
+  double neighbour_offset_m = 0;  ///< ... how far left of R the next fore-edge's right edge lies (0 = not seen)
+  double neighbour_width_m = 0;   ///< ... the next fore-edge's width (0 = not seen)
   std::string message;
 };
 
@@ -311,7 +313,7 @@ class LibraryCycle {
   void start_linear(std::vector<Eigen::Isometry3d> waypoints, double guard = 0);
   /// Closes the plates (grasp) or opens them to `open_width` (<= 0: the full opening).
   void start_gripper(bool grasp, double open_width = 0);
-  /// This attempt's plate opening for the grasp (plate_opening() with the corner servo's fore-edge width).
+  /// This attempt's plate opening for the grasp (plate_opening() with the corner servo's fore-edges).
   PlateOpening grasp_opening() const;
   /// The geometry with this attempt's grasp_opening() offset.
   CycleGeometry grasp_geometry() const;
@@ -374,7 +376,7 @@ class LibraryCycle {
       0.0;  ///< grasp Z of the book's front for the corner servo: P1.z when P1 is valid, else the model's
   std::optional<DecisionEvent> early_decision_;  ///< a decision that arrived before its servo status
   Eigen::Isometry3d gp_base_ = Eigen::Isometry3d::Identity();
-  double front_width_ = 0.0;  ///< this attempt's fore-edge width from the corner servo (0 = not measured)
+  ForeEdges fore_edges_;  ///< this attempt's fore-edges as the corner servo measured them (0 = not measured)
   bool user_event_sent_ = false;
   bool stopping_foreign_motion_ = false;  ///< started with the arm executing a motion it did not command
   int64_t last_foreign_stop_utime_ = 0;   ///< when that motion was last sent a STOP

@@ -177,7 +177,7 @@ SessionOutput ServoSession::on_request(const ServoRequest& request) {
   holding_ = false;
   last_lost_reason_.clear();
   sightings_.clear();
-  sighting_widths_px_.clear();
+  sighting_extents_.clear();
   start_position_ = tcp_.translation();
   twist_.setZero();
   corner_.reset();
@@ -225,12 +225,24 @@ Eigen::Vector3d ServoSession::moved_since(int64_t capture_utime) const {
   return Eigen::Vector3d(d.x(), d.y(), std::atan2(turned(1, 0), turned(0, 0)));
 }
 
-double ServoSession::front_width_at(const Eigen::Vector3d& corner_in_base) const {
+void set_next_fore_edge(const std::vector<ForeEdgeCandidate>& candidates, BookObservation* obs) {
+  const double r = obs->r_px.x();
+  const ForeEdgeCandidate* next = nullptr;
+  for (const auto& c : candidates)
+    if (c.accepted && std::isfinite(c.corner_x_px) && std::isfinite(c.width_px) && c.width_px > 0 &&
+        c.corner_x_px < r - 1.0 && (!next || c.corner_x_px > next->corner_x_px))
+      next = &c;
+  if (!next) return;
+  obs->neighbour_offset_px = r - next->corner_x_px;
+  obs->neighbour_width_px = next->width_px;
+}
+
+double ServoSession::metres_at(const Eigen::Vector3d& corner_in_base, double (*pixels)(const ViewExtents&)) const {
   std::vector<double> widths;
   for (size_t i = 0; i < sightings_.size(); ++i) {
     const double depth = (sightings_[i].camera_in_base.inverse() * corner_in_base).z();
-    if (sighting_widths_px_[i] > 0 && depth > 0)
-      widths.push_back(sighting_widths_px_[i] * depth / geo_.intrinsics().fx);
+    const double px = pixels(sighting_extents_[i]);
+    if (px > 0 && depth > 0) widths.push_back(px * depth / geo_.intrinsics().fx);
   }
   if (widths.empty()) return 0.0;
   std::nth_element(widths.begin(), widths.begin() + static_cast<long>(widths.size() / 2), widths.end());
@@ -257,7 +269,7 @@ SessionOutput ServoSession::on_book(const BookObservation& obs) {
   const std::optional<Eigen::Isometry3d> at_capture = pose_at(obs.utime);
   if (at_capture) {
     sightings_.push_back({*at_capture * geo_.camera_in_gripper(), obs.r_px});
-    sighting_widths_px_.push_back(obs.width_px);
+    sighting_extents_.push_back({obs.width_px, obs.neighbour_offset_px, obs.neighbour_width_px});
   }
   if (s.converged) {
     std::string why;
@@ -265,13 +277,18 @@ SessionOutput ServoSession::on_book(const BookObservation& obs) {
         triangulate_corner(sightings_, geo_.intrinsics(), p_.corner_triangulation, &why);
     std::string message =
         fmt("R within %.2f px of the target (%.1f, %.1f)", s.error_px.norm(), s.target_px.x(), s.target_px.y());
-    double front_width = 0;
+    double front_width = 0, neighbour_offset = 0, neighbour_width = 0;
     if (corner) {
       const Eigen::Vector3d in_tcp = at_capture ? at_capture->inverse() * corner->point : Eigen::Vector3d::Zero();
       message += fmt("; R triangulated %.1f mm ahead of the TCP", in_tcp.z() * 1e3) +
                  fmt(" from %.0f views over %.1f mm", corner->sightings, corner->baseline_m * 1e3);
-      front_width = front_width_at(corner->point);
+      front_width = metres_at(corner->point, [](const ViewExtents& v) { return v.width_px; });
       if (front_width > 0) message += fmt("; fore-edge %.1f mm wide", front_width * 1e3);
+      neighbour_offset = metres_at(corner->point, [](const ViewExtents& v) { return v.neighbour_offset_px; });
+      neighbour_width = metres_at(corner->point, [](const ViewExtents& v) { return v.neighbour_width_px; });
+      if (neighbour_offset > 0 && neighbour_width > 0)
+        message +=
+            fmt("; the next fore-edge %.1f mm left of R, %.1f mm wide", neighbour_offset * 1e3, neighbour_width * 1e3);
     } else {
       message += "; R not triangulated: " + why;
     }
@@ -286,6 +303,8 @@ SessionOutput ServoSession::on_book(const BookObservation& obs) {
     if (!out.reports.empty()) {
       out.reports.back().corner = corner;
       out.reports.back().front_width_m = front_width;
+      out.reports.back().neighbour_offset_m = neighbour_offset;
+      out.reports.back().neighbour_width_m = neighbour_width;
     }
     return out;
   }

@@ -81,7 +81,22 @@ struct BookObservation {
   Eigen::Vector2d r_px = Eigen::Vector2d::Zero();
   double slope_rad = 0;
   double width_px = 0;  ///< the selected fore-edge's width at its top (book_width_px); <= 0 = not given
+  /// The next fore-edge to the left (BwH's accepted candidate with the largest corner x left of R): how many
+  /// pixels its upper-right corner lies left of R, and its width; <= 0 = none seen.
+  double neighbour_offset_px = 0;
+  double neighbour_width_px = 0;
 };
+
+/// A BwH candidate as the servo reads it (book_candidate_t without LCM).
+struct ForeEdgeCandidate {
+  double corner_x_px = 0;  ///< its upper-right corner's column
+  double width_px = 0;     ///< its width in columns
+  bool accepted = false;   ///< BwH accepted it as a book
+};
+
+/// Sets `obs`'s neighbour_offset_px and neighbour_width_px from the accepted candidate whose corner lies nearest left
+/// of R (more than a pixel left of it); leaves them 0 when there is none or R is not finite.
+void set_next_fore_edge(const std::vector<ForeEdgeCandidate>& candidates, BookObservation* obs);
 
 /// A command for the arm driver.
 struct ServoCommand {
@@ -108,6 +123,10 @@ struct ServoReport {
   /// BOOK_CORNER CONVERGED with `corner`: the fore-edge's width in metres, the median over the task's views of
   /// width_px x (R's depth in that view's camera) / fx; 0 when R was not triangulated or no view gave a width.
   double front_width_m = 0;
+  /// BOOK_CORNER CONVERGED with `corner`: the fore-edge left of the target's, measured like front_width_m: how far
+  /// its right edge lies left of R, and its width (m); 0 when no view saw it.
+  double neighbour_offset_m = 0;
+  double neighbour_width_m = 0;
   std::string message;
 };
 
@@ -146,8 +165,13 @@ class ServoSession {
   int64_t now_utime() const { return now_; }
 
  private:
-  /// The fore-edge's width (m) from the views' widths at `corner_in_base` (see ServoReport::front_width_m).
-  double front_width_at(const Eigen::Vector3d& corner_in_base) const;
+  /// What BwH measured across the fore-edges in one view (<= 0: not measured).
+  struct ViewExtents {
+    double width_px = 0, neighbour_offset_px = 0, neighbour_width_px = 0;
+  };
+  /// The median over the corner task's views of `pixels(view)` x (depth of `corner_in_base` in that view's camera)
+  /// / fx, over the views where `pixels` is > 0: a length across the fore-edges at R's depth (m); 0 = none.
+  double metres_at(const Eigen::Vector3d& corner_in_base, double (*pixels)(const ViewExtents&)) const;
   void advance(int64_t utime, SessionOutput* out);
   void finish(ServoState state, const std::string& message, SessionOutput* out,
               const std::optional<Eigen::Isometry3d>& pose = std::nullopt);
@@ -189,7 +213,7 @@ class ServoSession {
   double slope_error_ = 0;
   std::string last_lost_reason_;
   std::vector<CornerSighting> sightings_;  ///< the corner task's views of R (camera pose at capture, pixel)
-  std::vector<double> sighting_widths_px_;  ///< BwH's fore-edge width in each of sightings_ (<= 0: none)
+  std::vector<ViewExtents> sighting_extents_;  ///< what BwH measured across the fore-edges in each of sightings_
 };
 
 }  // namespace bookgrasp

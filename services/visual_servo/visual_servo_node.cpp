@@ -122,7 +122,7 @@ void VisualServoNode::emit(const SessionOutput& out) {
     publish(settings_.arm_command_channel, m);
   }
   for (const ServoReport& r : out.reports) {
-    servo_status_t m;
+    servo_status_t m{};
     m.utime = r.utime;
     m.request_id = r.request_id;
     m.mode = static_cast<int8_t>(r.mode);
@@ -138,6 +138,8 @@ void VisualServoNode::emit(const SessionOutput& out) {
     m.corner_baseline_m = r.corner ? r.corner->baseline_m : 0.0;
     m.corner_rms_px = r.corner ? r.corner->rms_px : 0.0;
     m.front_width_m = r.front_width_m;
+    m.neighbour_offset_m = r.neighbour_offset_m;
+    m.neighbour_width_m = r.neighbour_width_m;
     m.message = r.message;
     publish(settings_.servo_status_channel, m);
   }
@@ -201,6 +203,9 @@ void VisualServoNode::on_book(const book_features_hand_t& msg) {
   o.r_px = Eigen::Vector2d(msg.r_px[0], msg.r_px[1]);
   o.slope_rad = msg.slope_rad;
   o.width_px = std::isfinite(msg.book_width_px) ? msg.book_width_px : 0.0;
+  std::vector<ForeEdgeCandidate> candidates;
+  for (const auto& c : msg.candidates) candidates.push_back({c.corner_r_px[0], c.width_px, c.accepted != 0});
+  if (msg.found) set_next_fore_edge(candidates, &o);
   if (msg.found && (!o.r_px.allFinite() || !std::isfinite(o.slope_rad))) {
     reject(settings_.book_features_channel, "found=true but r_px or slope_rad is not finite");
     return;

@@ -95,7 +95,7 @@ servo_request_t request(int64_t utime, int64_t id, int8_t mode, int rank = 0) {
 
 servo_status_t status(int64_t utime, int64_t id, int8_t mode, int8_t state, Eigen::Vector3d pos_base,
                       double slope = 0.0) {
-  servo_status_t s;
+  servo_status_t s{};  // every field zero: no triangulated corner, no widths
   s.utime = utime;
   s.request_id = id;
   s.mode = mode;

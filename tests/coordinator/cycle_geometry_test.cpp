@@ -37,19 +37,45 @@ TEST(CycleGeometry, AMeasuredForeEdgeNarrowsThePlatesOnTheLeftOnly) {
   g.grasp_offset_y = -0.015;  // full 6 cm opening: right plate 15 mm right of GP, left plate 45 mm left of it
   g.width_left_clearance = 0.008;
   // A 12 mm fore-edge: the left plate's inner face 8 mm left of the book, the right one where it was.
-  const PlateOpening narrow = plate_opening(0.012, 0.06, g);
+  const PlateOpening narrow = plate_opening({0.012, 0, 0}, 0.06, g);
   EXPECT_NEAR(narrow.width, 0.035, 1e-12);
   EXPECT_NEAR(narrow.offset_y + 0.5 * narrow.width, 0.015, 1e-12);   // right plate
   EXPECT_NEAR(narrow.offset_y - 0.5 * narrow.width, -0.020, 1e-12);  // left plate: 12 + 8 mm left of GP
   // Not measured (0, NaN, negative), switched off, or a book that needs the full opening: the paper's full opening.
   for (const double w : {0.0, double(NAN), -0.01, 0.040}) {
-    const PlateOpening full = plate_opening(w, 0.06, g);
+    const PlateOpening full = plate_opening({w, 0, 0}, 0.06, g);
     EXPECT_EQ(full.width, 0.06) << w;
     EXPECT_EQ(full.offset_y, -0.015) << w;
   }
   CycleGeometry off = g;
   off.width_left_clearance = 0.0;
-  EXPECT_EQ(plate_opening(0.012, 0.06, off).width, 0.06);
+  EXPECT_EQ(plate_opening({0.012, 0, 0}, 0.06, off).width, 0.06);
+  // A measured neighbour changes nothing while left_plate_on_neighbour is off.
+  EXPECT_NEAR(plate_opening({0.012, 0.019, 0.020}, 0.06, g).width, 0.035, 1e-12);
+}
+
+TEST(CycleGeometry, TheLeftPlateGoesToTheNeighboursMiddle) {
+  CycleGeometry g;
+  g.grasp_offset_y = -0.015;  // right plate 15 mm right of GP
+  g.left_plate_on_neighbour = true;
+  g.plate_thickness = 0.010;
+  g.left_plate_min_clearance = 0.003;
+  // Far_cart seed 1's second book: 17.7 mm, a 7 mm gap, then a 20 mm book whose middle lies 34.7 mm left of R. The
+  // full opening put the left plate 45-55 mm left of GP, beyond that book, which then stood between the plates.
+  const PlateOpening o = plate_opening({0.0177, 0.0247, 0.020}, 0.06, g);
+  const double left_inner = -(o.offset_y - 0.5 * o.width);
+  EXPECT_NEAR(left_inner, 0.0347 - 0.005, 1e-12);         // the plate's middle on the neighbour's middle
+  EXPECT_NEAR(o.offset_y + 0.5 * o.width, 0.015, 1e-12);  // the right plate where it was
+  // A thin neighbour right against the book: the plate keeps its clearance off the book itself.
+  const PlateOpening thin = plate_opening({0.020, 0.021, 0.006}, 0.06, g);
+  EXPECT_NEAR(-(thin.offset_y - 0.5 * thin.width), 0.023, 1e-12);
+  // No neighbour seen: the width rule, here off, so the full opening; a neighbour beyond the full opening: full.
+  EXPECT_EQ(plate_opening({0.0177, 0.0, 0.0}, 0.06, g).width, 0.06);
+  EXPECT_EQ(plate_opening({0.0177, 0.040, 0.020}, 0.06, g).width, 0.06);
+  g.width_left_clearance = 0.008;
+  EXPECT_NEAR(plate_opening({0.0177, 0.0, 0.0}, 0.06, g).width, 0.015 + 0.0177 + 0.008, 1e-12);
+  // No fore-edge width: nothing to keep the plate off the book, the full opening.
+  EXPECT_EQ(plate_opening({0.0, 0.0247, 0.020}, 0.06, g).width, 0.06);
 }
 
 TEST(CycleGeometry, TheCornerServoStandoffReachesTheBooksFront) {

@@ -79,6 +79,7 @@ class FakeLibrary {
   int missed_holder_grasps = 0;              ///< ... on the holder (the book stays there)
   bool servo_silent = false;                 ///< servo never answers (timeouts)
   bool servo_measures_width = false;         ///< the corner servo's CONVERGED carries the right-most book's width
+                                             ///< (and, with a book left of it, that book's offset and width)
   /// > 0: the stripe servo never finds an end and moves the TCP left (grasp -Y) at this speed (m/s) until it is
   /// cancelled or the arm stopped (a free stripe running out of the image on the left)
   double stripe_runs_left_m_s = 0.0;
@@ -354,6 +355,10 @@ class FakeLibrary {
           s.mode = r.servo_mode;
           s.state = 2;  // CONVERGED
           if (r.servo_mode == 1 && servo_measures_width && !upper.empty()) s.front_width_m = upper.front().width;
+          if (r.servo_mode == 1 && servo_measures_width && upper.size() > 1) {  // the next fore-edge to the left
+            s.neighbour_offset_m = upper[0].right_y - upper[1].right_y;
+            s.neighbour_width_m = upper[1].width;
+          }
           answers.push_back([&cycle, s] { return cycle.on_servo(s); });
           if (r.servo_mode == 2) {  // STRIPE_END: PS where the right-most book hides the stripe
             ps = Eigen::Vector3d(0.10, upper.empty() ? -0.395 : upper.front().right_y, -0.10);

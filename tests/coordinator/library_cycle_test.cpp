@@ -342,18 +342,26 @@ TEST(LibraryCycle, AMissedGraspFromTheHolderBacksOutStraightBeforePlanning) {
 
 TEST(LibraryCycle, AForeEdgeWidthFromTheCornerServoOpensThePlatesOnlySoFar) {
   // coordinator.yaml: open_width_m 0.06, offset_y_m -0.015 (right plate 15 mm right of GP); width_left_clearance_m is
-  // shipped off (0), set to 8 mm here.
+  // shipped off (0), set to 8 mm here. left_plate_on_neighbour (plate 10 mm, clearance 3 mm): the left plate's middle
+  // on the next book's middle; three_books() stand 2 mm apart, so books 0 and 1 get it, book 2 (none left of it)
+  // the width rule.
   const CycleSettings shipped = settings();
   ASSERT_EQ(shipped.geometry.width_left_clearance, 0.0);
   ASSERT_NEAR(shipped.gripper_open_width, 0.06, 1e-12);
-  for (const auto& [clearance, width_given] : {std::pair{0.008, false}, std::pair{0.008, true}, std::pair{0.0, true}}) {
-    SCOPED_TRACE("clearance " + std::to_string(clearance) + (width_given ? ", width measured" : ", no width"));
+  ASSERT_NEAR(shipped.geometry.plate_thickness, 0.010, 1e-12);
+  struct Case {
+    double clearance;
+    bool width_given, on_neighbour;
+  };
+  for (const Case& k : {Case{0.008, false, false}, Case{0.008, true, false}, Case{0.0, true, false},
+                        Case{0.008, true, true}, Case{0.0, false, true}}) {
+    SCOPED_TRACE("clearance " + std::to_string(k.clearance) + (k.width_given ? ", width measured" : ", no width") +
+                 (k.on_neighbour ? ", left plate on the neighbour" : ""));
     CycleSettings cs = shipped;
-    cs.geometry.width_left_clearance = clearance;
-    const bool measured = width_given && clearance > 0;  // the opening follows the width
+    cs.geometry.width_left_clearance = k.clearance;
+    cs.geometry.left_plate_on_neighbour = k.on_neighbour;
     FakeLibrary w(three_books());
-    w.servo_measures_width = width_given;
-    w.servo_measures_width = measured;
+    w.servo_measures_width = k.width_given;
     LibraryCycle cycle(cs, std::nullopt);
     w.run(cycle, [&] { return done_or_aborted(cycle); });
     ASSERT_EQ(cycle.state(), CycleState::kDone) << cycle.status().message;
@@ -367,9 +375,14 @@ TEST(LibraryCycle, AForeEdgeWidthFromTheCornerServoOpensThePlatesOnlySoFar) {
       if (q.kind != CycleRequest::Kind::kPlan || !after_servo) continue;
       after_servo = false;
       ASSERT_FALSE(q.then_poses.empty());
-      const FakeBook b = three_books()[book];
-      const double width = measured ? b.width + 0.015 + 0.008 : 0.06;
-      const double right_plate = 0.015, left_plate = measured ? -(b.width + 0.008) : -0.045;
+      const std::vector<FakeBook> books = three_books();
+      const FakeBook b = books[book];
+      double left_plate = -0.045;  // the full opening
+      if (k.width_given && k.on_neighbour && book + 1 < books.size())
+        left_plate = -(b.right_y - books[book + 1].right_y + 0.5 * books[book + 1].width - 0.005);
+      else if (k.width_given && k.clearance > 0)
+        left_plate = -(b.width + k.clearance);
+      const double right_plate = 0.015, width = right_plate - left_plate;
       const Eigen::Vector3d insert = hand_grasp_frame().inverse() * q.then_poses.front().translation();
       EXPECT_NEAR(insert.y() - b.right_y + 0.5 * width, right_plate, 1e-9) << "book " << book;
       EXPECT_NEAR(insert.y() - b.right_y - 0.5 * width, left_plate, 1e-9) << "book " << book;

@@ -48,6 +48,8 @@ struct CornerScene {
   Eigen::Vector3d corner{0.0, 0.0, 0.3};
   double roll_rad = 0.0;
   double width_m = 0.03;  ///< the top edge's length (the fore-edge's width)
+  double neighbour_offset_m = 0.0;  ///< the next fore-edge's right end this far left of R along the edge (0 = none)
+  double neighbour_width_m = 0.0;   ///< ... and its width
 
   /// Pixel of R and image slope (atan2(dy, dx)) seen from `tcp` (W); the top edge's width in image columns (as
   /// page_face_detection measures it) in `width_px` if given.
@@ -66,6 +68,22 @@ struct CornerScene {
     const Eigen::Vector2d d = pa - pb;  // left-to-right along the edge
     *slope = std::atan2(d.y(), d.x());
     if (width_px) *width_px = std::abs(d.x());
+    return true;
+  }
+
+  /// The next fore-edge as BwH would give it from `tcp`: how many image columns its upper-right corner lies left of
+  /// R, and its width in columns. False when the scene has none.
+  bool observe_neighbour(const HandEyeGeometry& g, const Eigen::Isometry3d& tcp, double* offset_px,
+                         double* width_px) const {
+    if (!(neighbour_width_m > 0)) return false;
+    const Eigen::Isometry3d cam = tcp * g.camera_in_gripper();
+    const Eigen::Vector3d dir = Eigen::AngleAxisd(roll_rad, Eigen::Vector3d::UnitZ()) * Eigen::Vector3d(0, -1, 0);
+    const auto column = [&](double along) {
+      const Eigen::Vector3d p = cam.inverse() * (corner + along * dir);
+      return g.intrinsics().cx + g.intrinsics().fx * p.x() / p.z();
+    };
+    *offset_px = column(0.0) - column(neighbour_offset_m);
+    *width_px = column(neighbour_offset_m) - column(neighbour_offset_m + neighbour_width_m);
     return true;
   }
 };

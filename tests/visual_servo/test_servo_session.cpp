@@ -321,7 +321,8 @@ TEST(StripeServoLatency, ImagesASecondLateStillConvergeOnTheTrueEnd) {
 /// start and `corner_z` ahead of it (the servo assumes 0.22 m), its top edge rolled 3 degrees. Returns the final
 /// report.
 ServoReport run_late_corner(double latency_s, bool compensate, double corner_z = 0.22, double target_above_m = 0.0,
-                            Eigen::Isometry3d* final_tcp = nullptr, bool bwh_gives_width = true) {
+                            Eigen::Isometry3d* final_tcp = nullptr, bool bwh_gives_width = true,
+                            double neighbour_offset_m = 0.0, double neighbour_width_m = 0.0) {
   const HandEyeGeometry geo = test::project_geometry();
   BookCornerServoParams cp;
   cp.target_above_tcp_m = target_above_m;
@@ -336,6 +337,8 @@ ServoReport run_late_corner(double latency_s, bool compensate, double corner_z =
   test::CornerScene scene;
   scene.corner = Eigen::Vector3d(0.04, 0.03, corner_z);
   scene.roll_rad = 3.0 * M_PI / 180.0;
+  scene.neighbour_offset_m = neighbour_offset_m;
+  scene.neighbour_width_m = neighbour_width_m;
   ServoRequest r;
   r.utime = kT0;
   r.request_id = 11;
@@ -346,6 +349,7 @@ ServoReport run_late_corner(double latency_s, bool compensate, double corner_z =
     BookObservation o;
     o.utime = t;
     o.found = scene.observe(geo, at, &o.r_px, &o.slope_rad, bwh_gives_width ? &o.width_px : nullptr);
+    if (o.found) scene.observe_neighbour(geo, at, &o.neighbour_offset_px, &o.neighbour_width_px);
     return o;
   };
   const auto [report, tcp] =
@@ -392,6 +396,26 @@ TEST(CornerServoTargetAbove, TheTcpEndsBelowRAndP2IsAtR) {
 
 // Not in the paper: the converged report carries R located from the servo's views; it is right where the assumed
 // standoff is not (a front 6 cm deeper than assumed puts the converged TCP ~2 cm low, the camera being 6 cm above it).
+TEST(NextForeEdge, TheAcceptedCandidateNearestLeftOfRIsTheNeighbour) {
+  BookObservation o;
+  o.r_px = Eigen::Vector2d(400, 200);
+  // R's own candidate (400), one rejected nearer (380), the neighbour (372, 25 px), one further left (330), one right
+  // of R (450).
+  set_next_fore_edge({{400, 40, true}, {380, 10, false}, {372, 25, true}, {330, 30, true}, {450, 20, true}}, &o);
+  EXPECT_DOUBLE_EQ(o.neighbour_offset_px, 28);
+  EXPECT_DOUBLE_EQ(o.neighbour_width_px, 25);
+  // None left of R, or none accepted, or a width that is no width: nothing measured.
+  for (const auto& cands : {std::vector<ForeEdgeCandidate>{{400, 40, true}, {450, 20, true}},
+                            std::vector<ForeEdgeCandidate>{{372, 25, false}},
+                            std::vector<ForeEdgeCandidate>{{372, double(NAN), true}, {360, 0, true}}}) {
+    BookObservation none;
+    none.r_px = o.r_px;
+    set_next_fore_edge(cands, &none);
+    EXPECT_EQ(none.neighbour_offset_px, 0);
+    EXPECT_EQ(none.neighbour_width_px, 0);
+  }
+}
+
 TEST(CornerServoTriangulation, TheConvergedReportLocatesRAtItsTrueDepth) {
   for (const double corner_z : {0.22, 0.28, 0.16}) {
     for (const double latency : {0.0, 0.7}) {
@@ -415,6 +439,16 @@ TEST(CornerServoTriangulation, TheConvergedReportLocatesRAtItsTrueDepth) {
   ASSERT_EQ(no_width.state, ServoState::kConverged) << no_width.message;
   EXPECT_EQ(no_width.front_width_m, 0.0);
   EXPECT_EQ(no_width.message.find("fore-edge"), std::string::npos) << no_width.message;
+  EXPECT_EQ(no_width.neighbour_width_m, 0.0);
+  // The next fore-edge (a 2 mm gap, 18 mm wide) measured the same way, at R's depth: where the assumed standoff
+  // (0.22 m) is not, too.
+  for (const double corner_z : {0.22, 0.28}) {
+    const ServoReport next = run_late_corner(0.0, true, corner_z, 0.0, nullptr, true, 0.032, 0.018);
+    ASSERT_EQ(next.state, ServoState::kConverged) << next.message;
+    EXPECT_NEAR(next.neighbour_offset_m, 0.032, 1e-3) << next.message;
+    EXPECT_NEAR(next.neighbour_width_m, 0.018, 1e-3) << next.message;
+    EXPECT_NE(next.message.find("the next fore-edge 32."), std::string::npos) << next.message;
+  }
   // The assumed depth's error shows in the converged pose's X, not in the triangulated corner.
   const ServoReport deep = run_late_corner(0.0, true, 0.28);
   EXPECT_GT(std::abs(deep.converged_pose->translation().x() - 0.04), 0.01);
