@@ -434,7 +434,10 @@ void ArbiterNode::on_arm_state(const arm_state_t& msg) {
   for (double v : msg.velocities) moving = moving || !(std::abs(v) <= s_.p1_arm_still_joint_speed);
   if (moving && (!last_arm_motion_utime_ || msg.utime > *last_arm_motion_utime_)) last_arm_motion_utime_ = msg.utime;
   if (!width_pending_) return;
-  if (!msg.gripper_contact || msg.gripper_width_m <= 0) {
+  // The width is read with the arm still (the plates close on the book at the end of the insertion); while the arm
+  // moves, a plate touching a neighbour on the way in is not a grasp (far_cart seed 2003: 36.7 mm taken as the width
+  // of an 18 mm book while the narrowed plates went in).
+  if (moving || !msg.gripper_contact || msg.gripper_width_m <= 0) {
     settle_start_utime_ = -1;
     return;
   }

@@ -50,6 +50,11 @@ struct CycleGeometry {
   double plate_thickness = 0.010;  ///< a plate's thickness across the books (Y)
   /// The left plate's inner face stays at least this far left of the book's measured fore-edge.
   double left_plate_min_clearance = 0.003;
+  /// Not in the paper: plates closed this much wider than the fore-edge the corner servo measured hold more than the
+  /// book (its neighbour too: a double lift). The attempt fails before the extraction, and the book's next attempts
+  /// open the plates only to the fore-edge + retry_left_clearance. 0 = no check.
+  double more_than_the_book = 0.0;
+  double retry_left_clearance = 0.005;  ///< see more_than_the_book
   double pre_grasp_distance = 0.10; ///< pre-grasp pose this far in front of GP along -Z
   /// Deepest GP (grasp Z) the pre-grasp and the extraction's end are measured from: a deeper front (books
   /// pushed back by an earlier grasp's left plate) gets the pre-grasp and the extraction's end a front at this
@@ -135,6 +140,14 @@ struct ForeEdges {
 /// front_width + width_left_clearance left of GP; never wider than the full opening. Otherwise: {open_width,
 /// grasp_offset_y}.
 PlateOpening plate_opening(const ForeEdges& edges, double open_width, const CycleGeometry& g);
+
+/// The opening for a book whose earlier grasp closed on more than the book (more_than_the_book): the left plate's
+/// inner face retry_left_clearance left of the measured fore-edge; the full opening when no width was measured.
+PlateOpening plate_opening_after_more_than_the_book(const ForeEdges& edges, double open_width, const CycleGeometry& g);
+
+/// True when plates closed to `plate_distance` hold more than the fore-edge `edges.front_width` (a measured width
+/// and more_than_the_book > 0 only).
+bool holds_more_than_the_book(double plate_distance, const ForeEdges& edges, const CycleGeometry& g);
 /// Book height above its support at the TCP: GP.x (top above the upper shelf) plus the X offset.
 double tcp_height_on_book(const Eigen::Vector3d& gp_grasp, const CycleGeometry& g);
 /// TCP height above the book's bottom for the grasp from the holder: `tcp_height` (the grasp from the shelf)

@@ -361,7 +361,9 @@ void LibraryCycle::start_linear(std::vector<Eigen::Isometry3d> waypoints, double
 }
 
 PlateOpening LibraryCycle::grasp_opening() const {
-  return plate_opening(fore_edges_, s_.gripper_open_width, s_.geometry);
+  return narrow_after_more_than_the_book_
+             ? plate_opening_after_more_than_the_book(fore_edges_, s_.gripper_open_width, s_.geometry)
+             : plate_opening(fore_edges_, s_.gripper_open_width, s_.geometry);
 }
 
 CycleGeometry LibraryCycle::grasp_geometry() const {
@@ -489,6 +491,15 @@ void LibraryCycle::handle_gripper_result(double width, bool contact) {
   if (!contact || width < s_.min_book_width) {
     fail("nothing grasped in " + cycle_state_name(state_) + ": the gripper closed to " + mm(width) +
          (contact ? "" : " without contact"));
+    return;
+  }
+  if (state_ == CycleState::kCloseGripper && holds_more_than_the_book(width, fore_edges_, s_.geometry)) {
+    // The plates hold the neighbour too (its side within the opening): lifting now takes two books. Open, back out
+    // and try again with the plates opened only to the book.
+    narrow_after_more_than_the_book_ = true;
+    fail("the plates closed to " + mm(width) + " on a fore-edge " + mm(fore_edges_.front_width) +
+         " wide: more than the book between them (grasp.more_than_the_book_m " + mm(s_.geometry.more_than_the_book) +
+         "); the next attempt opens them to the book only");
     return;
   }
   if (state_ == CycleState::kCloseGripper) {
@@ -635,6 +646,7 @@ void LibraryCycle::book_done(bool handed_over) {
     message_ = "book " + std::to_string(b.index) + where;
   }
   attempt_ = 1;
+  narrow_after_more_than_the_book_ = false;
 }
 
 void LibraryCycle::succeed(CycleState next) {
@@ -660,7 +672,10 @@ void LibraryCycle::enter(CycleState s) {
     case CycleState::kBackOut: {
       out_.push_back(make_request(CycleRequest::Kind::kGripperMove));
       out_.back().id = next_id();
-      out_.back().width = grasp_opening().width;  // not wider than for the grasp: the plates are among the books
+      // Not wider than for the grasp (the plates are among the books), but open: after a grasp on more than the book
+      // the next opening is narrower than the plates are now.
+      out_.back().width =
+          std::min(s_.gripper_open_width, std::max(grasp_opening().width, (arm_ ? arm_->gripper_width : 0.0) + 0.01));
       out_.back().force = s_.gripper_force;
       out_.back().speed = s_.gripper_speed;
       const Eigen::Isometry3d here = arm_->end_effector;

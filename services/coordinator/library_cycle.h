@@ -377,6 +377,8 @@ class LibraryCycle {
   std::optional<DecisionEvent> early_decision_;  ///< a decision that arrived before its servo status
   Eigen::Isometry3d gp_base_ = Eigen::Isometry3d::Identity();
   ForeEdges fore_edges_;  ///< this attempt's fore-edges as the corner servo measured them (0 = not measured)
+  /// An earlier grasp of this book closed on more than it (geometry.more_than_the_book): open only so far now.
+  bool narrow_after_more_than_the_book_ = false;
   bool user_event_sent_ = false;
   bool stopping_foreign_motion_ = false;  ///< started with the arm executing a motion it did not command
   int64_t last_foreign_stop_utime_ = 0;   ///< when that motion was last sent a STOP

@@ -73,6 +73,9 @@ class FakeLibrary {
   int next_region_once = 0;                  ///< BwH rank 0 answers NEXT_REGION this many times
   int no_grasp_once = 0;                     ///< BwH answers NO_GRASP this many times
   int missed_grasps = 0;                     ///< the gripper closes on nothing this many times
+  /// The next N closes on the shelf take the right-most book and the one left of it: the plates stop at both
+  /// books' width (from the first's right cover to the second's left one)
+  int double_grasps = 0;
   /// P1 checks answer P1_INVALID (a P1 2 cm off PS) with this as the arbiter's front depth for the corner servo
   /// (gp_grasp's Z; NaN = the arbiter knew none)
   std::optional<double> invalid_p1_front_z;
@@ -114,6 +117,8 @@ class FakeLibrary {
   std::vector<std::pair<std::string, Eigen::Vector3d>> tcp_path;  ///< state and TCP position every tick
   std::vector<CycleRequest> requests;       ///< every request seen
   std::vector<int> arm_state_at_request;    ///< arm_state when each of `requests` was made
+  std::vector<std::string> requests_state;  ///< the cycle's state when each of `requests` was made
+  std::vector<std::string> messages;        ///< the cycle's status messages, consecutive duplicates collapsed
   std::vector<double> joints = std::vector<double>(7, 0.0);  ///< reported joints
   std::vector<std::string> user_events_sent;
   std::optional<Eigen::Vector3d> ps;        ///< the fake arbiter's PS
@@ -186,6 +191,8 @@ class FakeLibrary {
   void record(const LibraryCycle& c) {
     const std::string s = bookgrasp::cycle_state_name(c.state());
     if (states.empty() || states.back() != s) states.push_back(s);
+    const std::string m = c.status().message;
+    if (messages.empty() || messages.back() != m) messages.push_back(m);
   }
 
   void integrate() {
@@ -247,6 +254,7 @@ class FakeLibrary {
       requests.push_back(r);
       arm_state_at_request.push_back(arm_state);
       const std::string state = bookgrasp::cycle_state_name(cycle.state());
+      requests_state.push_back(state);
       switch (r.kind) {
         case CycleRequest::Kind::kPlan: {
           Plan p;
@@ -303,6 +311,9 @@ class FakeLibrary {
           } else if (in_gripper && state == "RELEASE_ON_LOWER_SHELF") {
             lower.emplace_back(*in_gripper, ee);
             in_gripper.reset();
+          } else if (in_gripper && state == "BACK_OUT") {  // opened among the books: it stays on the shelf
+            upper.push_front(*in_gripper);
+            in_gripper.reset();
           }
           break;
         case CycleRequest::Kind::kGripperGrasp:
@@ -310,6 +321,12 @@ class FakeLibrary {
             --missed_grasps;
             width = 0.0;
             contact = false;
+          } else if (state == "CLOSE_GRIPPER" && double_grasps > 0 && upper.size() > 1) {
+            --double_grasps;
+            in_gripper = upper.front();
+            upper.pop_front();
+            width = in_gripper->right_y - (upper.front().right_y - upper.front().width);
+            contact = true;
           } else if (state == "CLOSE_GRIPPER" && !upper.empty()) {
             in_gripper = upper.front();
             upper.pop_front();

@@ -396,6 +396,49 @@ TEST(LibraryCycle, AForeEdgeWidthFromTheCornerServoOpensThePlatesOnlySoFar) {
   }
 }
 
+TEST(LibraryCycle, PlatesClosedOnMoreThanTheBookTryAgainOpenedToTheBookOnly) {
+  // coordinator.yaml: more_than_the_book_m 7 mm, retry_left_clearance_m 5 mm. three_books(): book 0 25 mm wide, book 1
+  // 20 mm, 2 mm apart: a close on both stops at 47 mm.
+  CycleSettings cs = settings();
+  ASSERT_NEAR(cs.geometry.more_than_the_book, 0.007, 1e-12);
+  ASSERT_NEAR(cs.geometry.retry_left_clearance, 0.005, 1e-12);
+  FakeLibrary w(three_books());
+  w.servo_measures_width = true;
+  w.double_grasps = 1;
+  LibraryCycle cycle(cs, std::nullopt);
+  w.run(cycle, [&] { return done_or_aborted(cycle); });
+  ASSERT_EQ(cycle.state(), CycleState::kDone) << cycle.status().message;
+  EXPECT_EQ(cycle.progress().books_moved, 3);
+  EXPECT_EQ(cycle.progress().failures, 1);
+  // Book 0: the close on both, no EXTRACT, BACK_OUT, then a second attempt.
+  const std::vector<std::string> first = slice(w.states, "CLOSE_GRIPPER", 2);
+  EXPECT_EQ(first, (std::vector<std::string>{"CLOSE_GRIPPER", "BACK_OUT"}));
+  EXPECT_NE(std::find(w.messages.begin(), w.messages.end(),
+                      "attempt 2 at book 0 after: the plates closed to 47.0 mm on a fore-edge 25.0 mm wide: more than "
+                      "the book between them (grasp.more_than_the_book_m 7.0 mm); the next attempt opens them to the "
+                      "book only"),
+            w.messages.end());
+  // The openings for the grasps: full (60 mm) for book 0's first attempt, 15 + 25 + 5 mm for its second, the full
+  // opening again for book 1.
+  std::vector<double> openings;
+  for (size_t i = 0; i + 1 < w.requests.size(); ++i)
+    if (w.requests[i].kind == CycleRequest::Kind::kGripperMove && w.requests_state[i] == "OPEN_FOR_GRASP")
+      openings.push_back(w.requests[i].width);
+  ASSERT_GE(openings.size(), 3u);
+  EXPECT_NEAR(openings[0], 0.060, 1e-9);
+  EXPECT_NEAR(openings[1], 0.045, 1e-9);
+  EXPECT_NEAR(openings[2], 0.060, 1e-9);
+  // With the check off the grasp goes on with both books between the plates.
+  cs.geometry.more_than_the_book = 0.0;
+  FakeLibrary off(three_books());
+  off.servo_measures_width = true;
+  off.double_grasps = 1;
+  LibraryCycle unchecked(cs, std::nullopt);
+  off.run(unchecked, [&] { return done_or_aborted(unchecked); });
+  EXPECT_EQ(unchecked.progress().failures, 0);
+  EXPECT_EQ(slice(off.states, "CLOSE_GRIPPER", 2), (std::vector<std::string>{"CLOSE_GRIPPER", "EXTRACT"}));
+}
+
 TEST(LibraryCycle, TheArbitersFrontDepthSetsTheCornerServosStandoff) {
   // coordinator.yaml: book_front_z_m 0.01 (when the arbiter gives no depth), bwh_start_z_m -0.08.
   const CycleSettings cs = settings();
