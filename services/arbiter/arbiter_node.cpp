@@ -102,6 +102,8 @@ ArbiterSettings ArbiterSettings::from_config(const Config& root) {
   s.width_settle_s = root.get_double("book_width.settle_s", 0.0, 10.0);
   s.width_settle_tolerance = root.get_double("book_width.settle_tolerance_m", 0.00001, 0.01);
   s.width_open_margin = root.get_double("book_width.open_margin_m", 0.0, 0.05);
+  s.width_abandon_open = root.get_double("book_width.abandoned_open_m", 0.0005, 0.05);
+  s.width_abandon_within = root.get_double("book_width.abandoned_within_m", 0.001, 0.5);
   s.p1_arm_still_s = root.get_double("p1.arm_still_s", 0.0, 60.0);
   s.p1_arm_still_joint_speed = root.get_double("p1.arm_still_joint_speed_rad_s", 0.0001, 10.0);
   return s;
@@ -433,6 +435,24 @@ void ArbiterNode::on_arm_state(const arm_state_t& msg) {
   bool moving = msg.state == arm_state_t::EXECUTING;
   for (double v : msg.velocities) moving = moving || !(std::abs(v) <= s_.p1_arm_still_joint_speed);
   if (moving && (!last_arm_motion_utime_ || msg.utime > *last_arm_motion_utime_)) last_arm_motion_utime_ = msg.utime;
+  if (width_taken_) {
+    const Eigen::Vector3d tcp = pose_to_isometry(msg.end_effector).translation();
+    if ((tcp - width_taken_->tcp).norm() > s_.width_abandon_within) {
+      width_taken_.reset();  // the book left with the TCP: BW stands
+    } else if (msg.gripper_width_m > width_taken_->bw + s_.width_abandon_open) {
+      // The plates opened where they closed: the grasp was given up (the coordinator backs out), so the book is still
+      // on the shelf and PS goes back.
+      ps_ = width_taken_->ps_before;
+      grasp_point_t m = base_message(msg.utime, width_taken_->request_id);
+      if (ps_) put(m.ps_grasp, last_frame_.inverse() * *ps_);
+      m.valid = false;
+      m.reason = "PS_RESTORED: the plates opened to " + mm(msg.gripper_width_m) + " where they had closed to " +
+                 mm(width_taken_->bw) + ": the grasp was given up, PS is the one before that BW";
+      width_taken_.reset();
+      finish(&m, follow_, switch_note_);
+      publish(s_.channels.grasp_point, m);
+    }
+  }
   if (!width_pending_) return;
   // The width is read with the arm still (the plates close on the book at the end of the insertion); while the arm
   // moves, a plate touching a neighbour on the way in is not a grasp (far_cart seed 2003: 36.7 mm taken as the width
@@ -464,6 +484,7 @@ void ArbiterNode::on_arm_state(const arm_state_t& msg) {
   gp.translation() = last_frame_ * last_gp_grasp_;
   m.gp_base = isometry_to_pose(gp, "base", "gripper", msg.utime);
   const bool usable = bw <= s_.size_limits.l_max;
+  width_taken_ = WidthTaken{width_request_, bw, pose_to_isometry(msg.end_effector).translation(), ps_};
   if (usable) {
     const Eigen::Vector3d next = next_ps(last_ps_grasp_, last_gp_grasp_, bw);
     ps_ = last_frame_ * next;

@@ -74,6 +74,11 @@ struct ArbiterSettings {
   double width_settle_s = 0.2;          ///< the plate distance must hold this long (message time) ...
   double width_settle_tolerance = 0.0005;  ///< ... within this, with contact, to count as the book width
   double width_open_margin = 0.002;     ///< plates within this of L_max are open (touching a neighbour), not on a book
+  /// Not in the paper: plates that open more than this beyond the measured BW while the TCP is still within
+  /// width_abandon_within of where BW was read gave the grasp up (the coordinator backs out: more than the book
+  /// between the plates); PS goes back to what it was before BW moved it.
+  double width_abandon_open = 0.005;
+  double width_abandon_within = 0.05;   ///< see width_abandon_open (m of TCP travel)
   double p1_arm_still_s = 0.5;          ///< a P1 counts only from a frame taken this long after the arm last moved
                                         ///< (0 = every frame)
   double p1_arm_still_joint_speed = 0.01;  ///< rad/s: a joint faster than this means the arm moves
@@ -135,6 +140,14 @@ class ArbiterNode : public Component {
   Eigen::Isometry3d last_frame_ = Eigen::Isometry3d::Identity();
   int64_t settle_start_utime_ = -1;
   double settle_start_width_ = 0;
+  /// The last BOOK_WIDTH while the grasp may still be given up: BW, the TCP where it was read, PS before it moved.
+  struct WidthTaken {
+    int64_t request_id = 0;
+    double bw = 0;
+    Eigen::Vector3d tcp = Eigen::Vector3d::Zero();
+    std::optional<Eigen::Vector3d> ps_before;
+  };
+  std::optional<WidthTaken> width_taken_;
   std::optional<int64_t> last_arm_motion_utime_;  ///< latest ARM_STATE that showed the arm moving
   int64_t p1_skipped_arm_moving_ = 0;
 };

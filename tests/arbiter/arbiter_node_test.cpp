@@ -142,6 +142,24 @@ class ArbiterNodeTest : public testing::Test {
     send("SERVO_REQUEST", request(3000, 1, servo_request_t::STRIPE_END));
     send("SERVO_STATUS", status(4000, 1, servo_request_t::STRIPE_END, servo_status_t::CONVERGED, ps_base));
   }
+  /// A grasp whose plates close to 31 mm (BOOK_WIDTH moves PS 31 mm left), then open to 45 mm, at the shelf or
+  /// after the TCP went 10 cm up (EXTRACT's lift).
+  void grasp_then_open(bool carried_away) {
+    first_run({0.61, -0.30, 0.25}, {0.45, -0.305, 0.10});  // PS grasp (0.10, 0.255, -0.15)
+    send("SERVO_REQUEST", request(5000, 2, servo_request_t::BOOK_CORNER, 0));
+    send("SERVO_STATUS", status(6000, 2, servo_request_t::BOOK_CORNER, servo_status_t::CONVERGED, {0.45, -0.31, 0.26}));
+    ASSERT_EQ(out.got.size(), 3u);
+    for (int64_t t = 100000; t <= 400000; t += 100000) send("ARM_STATE", arm(t, 0.031, true));
+    ASSERT_EQ(out.got.size(), 4u);
+    ASSERT_EQ(out.got[3].reason.rfind("BOOK_WIDTH: BW = 31.0 mm", 0), 0u) << out.got[3].reason;
+    for (int i = 0; i < 3; ++i) EXPECT_NEAR(out.got[3].ps_grasp[i], (Eigen::Vector3d(0.10, 0.229, -0.15))(i), 1e-9);
+    arm_state_t away = arm(500000, 0.031, true, true);
+    if (carried_away) away.end_effector.position[2] += 0.10;
+    send("ARM_STATE", away);
+    arm_state_t open = arm(600000, 0.045, false, true);
+    open.end_effector = away.end_effector;
+    send("ARM_STATE", open);
+  }
   Composition comp;
   ArbiterNode* node = nullptr;
   Collector<grasp_point_t> out;
@@ -283,6 +301,25 @@ TEST_F(ArbiterNodeTest, P1FromAFrameTakenWhileTheArmMovedIsNotUsed) {
   // A frame taken still_s after the arm stopped counts again.
   send("BOOK_CORNER_STEREO", corner(12010000 + still_us, "god", true, {0.61, -0.30, 0.25}));
   EXPECT_EQ(node->p1_skipped_arm_moving(), 2);
+}
+
+// Plates that open again where they closed gave the grasp up (the coordinator's plate-distance check backs out of two
+// books): PS goes back to what it was before that BW moved it (the deployed seed 1 took the next book otherwise).
+TEST_F(ArbiterNodeTest, PlatesOpenedWhereTheyClosedRestorePs) {
+  grasp_then_open(false);
+  ASSERT_EQ(out.got.size(), 5u);
+  EXPECT_TRUE(starts_with(out.got[4].reason,
+                          "PS_RESTORED: the plates opened to 45.0 mm where they had closed to "
+                          "31.0 mm"))
+      << out.got[4].reason;
+  expect_vec(out.got[4].ps_grasp, {0.10, 0.255, -0.15}, "PS restored");
+  EXPECT_FALSE(out.got[4].valid);
+}
+
+// Plates that open after the TCP carried the book away (the holder) leave PS where BW put it.
+TEST_F(ArbiterNodeTest, PlatesOpenedAwayFromTheShelfKeepTheWidthsPs) {
+  grasp_then_open(true);
+  EXPECT_EQ(out.got.size(), 4u) << "the book went with the TCP: BW stands";
 }
 
 TEST_F(ArbiterNodeTest, FalseRegionAsksForNextRankThenGrasps) {
