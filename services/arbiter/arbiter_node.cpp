@@ -454,10 +454,12 @@ void ArbiterNode::on_arm_state(const arm_state_t& msg) {
     }
   }
   if (!width_pending_) return;
-  // The width is read with the arm still (the plates close on the book at the end of the insertion); while the arm
-  // moves, a plate touching a neighbour on the way in is not a grasp (far_cart seed 2003: 36.7 mm taken as the width
-  // of an 18 mm book while the narrowed plates went in).
-  if (moving || !msg.gripper_contact || msg.gripper_width_m <= 0) {
+  // The width is read while the arm executes no motion (the plates close on the book after the insertion); during
+  // one, a plate touching a neighbour on the way in is not a grasp (far_cart seed 2003: 36.7 mm taken as the width
+  // of an 18 mm book while the narrowed plates went in). Not the joint speeds: the arm still settles from the
+  // insertion while the plates close, and the coordinator's own settle then ended the close first, so no width was
+  // read at all.
+  if (msg.state == arm_state_t::EXECUTING || !msg.gripper_contact || msg.gripper_width_m <= 0) {
     settle_start_utime_ = -1;
     return;
   }

@@ -116,10 +116,9 @@ namespace {
 // --log --log-channels BOOK_CORNER_STEREO,SERVO_STATUS,SERVO_REQUEST,MARKERS,ARM_STATE,DETECTOR_SWITCH,GRASP_POINT
 // --out DIR, then DIR/logs/seed_5.lcmlog: two books through the whole cycle, the third ABORTED when the corner
 // servo stopped at a joint limit); re-recorded 2026-12-04 (stop 26) when the arbiter began to read the book width
-// with the arm still only (two books through the whole cycle, the third handed to the librarian: the lower shelf
-// could not take it); re-recorded 2026-12-03 (stop 20) when SERVO_STATUS gained the triangulated corner;
-// before (stop 19) when the P1 check's gp_grasp Z became the corner servo's front depth and the stereo front left of PS
-// (arbiter.yaml stereo_front) joined GP.z's rules.
+// only while the arm executes no motion (three books through the whole cycle); re-recorded 2026-12-03 (stop 20) when
+// SERVO_STATUS gained the triangulated corner; before (stop 19) when the P1 check's gp_grasp Z became the corner
+// servo's front depth and the stereo front left of PS (arbiter.yaml stereo_front) joined GP.z's rules.
 DiffReport replay_arbiter(const std::string& config_path) {
   const auto log = read_lcm_log(std::string(BOOKGRASP_SOURCE_DIR) + "/logs/samples/arbiter_seed5.lcm");
   std::vector<std::unique_ptr<Component>> cs;
