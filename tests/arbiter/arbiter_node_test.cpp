@@ -142,13 +142,19 @@ class ArbiterNodeTest : public testing::Test {
     send("SERVO_REQUEST", request(3000, 1, servo_request_t::STRIPE_END));
     send("SERVO_STATUS", status(4000, 1, servo_request_t::STRIPE_END, servo_status_t::CONVERGED, ps_base));
   }
-  /// A grasp whose plates close to 31 mm (BOOK_WIDTH moves PS 31 mm left), then open to 45 mm, at the shelf or
-  /// after the TCP went 10 cm up (EXTRACT's lift).
-  void grasp_then_open(bool carried_away) {
-    first_run({0.61, -0.30, 0.25}, {0.45, -0.305, 0.10});  // PS grasp (0.10, 0.255, -0.15)
+  /// The first run, then BwH rank 0 converging where P1 is: the GRASP decision, the third message. PS grasp (0.10,
+  /// 0.255, -0.15).
+  void grasp_decided() {
+    first_run({0.61, -0.30, 0.25}, {0.45, -0.305, 0.10});
     send("SERVO_REQUEST", request(5000, 2, servo_request_t::BOOK_CORNER, 0));
     send("SERVO_STATUS", status(6000, 2, servo_request_t::BOOK_CORNER, servo_status_t::CONVERGED, {0.45, -0.31, 0.26}));
     ASSERT_EQ(out.got.size(), 3u);
+    ASSERT_EQ(out.got[2].reason.rfind("GRASP", 0), 0u) << out.got[2].reason;
+  }
+  /// grasp_decided(), then plates closing to 31 mm (BOOK_WIDTH moves PS 31 mm left) and opening to 45 mm, at the
+  /// shelf or after the TCP went 10 cm up (EXTRACT's lift).
+  void grasp_then_open(bool carried_away) {
+    grasp_decided();
     for (int64_t t = 100000; t <= 400000; t += 100000) send("ARM_STATE", arm(t, 0.031, true));
     ASSERT_EQ(out.got.size(), 4u);
     ASSERT_EQ(out.got[3].reason.rfind("BOOK_WIDTH: BW = 31.0 mm", 0), 0u) << out.got[3].reason;
@@ -251,11 +257,7 @@ TEST_F(ArbiterNodeTest, WholeBookP1ValidGraspWidthAndNextPs) {
 // them: steady contact for 0.5 s, but the arm moves, so it is no width (far_cart seed 2003 took it for an 18 mm
 // book's). The close with the arm still gives the width.
 TEST_F(ArbiterNodeTest, AContactWhileTheArmMovesIsNoBookWidth) {
-  first_run({0.61, -0.30, 0.25}, {0.45, -0.305, 0.10});
-  send("SERVO_REQUEST", request(5000, 2, servo_request_t::BOOK_CORNER, 0));
-  send("SERVO_STATUS", status(6000, 2, servo_request_t::BOOK_CORNER, servo_status_t::CONVERGED, {0.45, -0.31, 0.26}));
-  ASSERT_EQ(out.got.size(), 3u);
-  ASSERT_TRUE(starts_with(out.got[2].reason, "GRASP")) << out.got[2].reason;
+  grasp_decided();
   for (int64_t t = 10000; t <= 510000; t += 100000) send("ARM_STATE", arm(t, 0.0367, true, true));
   EXPECT_EQ(out.got.size(), 3u) << "a plate touching something while the arm moves is not a grasp";
   for (int64_t t = 520000; t <= 820000; t += 100000) send("ARM_STATE", arm(t, 0.018, true));
