@@ -147,9 +147,12 @@ TEST(LibraryCycle, ThreeBooksWholeCycleEveryTransitionAndPlacements) {
   // Z = -0.04 + 0.03 (insertion) = -0.01. Base = (0.60 + Z, -0.05 - Y, X). X: the book was taken from the holder
   // with the TCP holder.regrasp_lower_m (0.015) lower than at its release, after it had dropped place_clearance_m
   // (0.005) onto the ledge, so the TCP is height - 0.015 + 0.005 above its bottom; the place leaves 0.005 below it:
-  // X = -0.32 + (height - 0.015 + 0.005) + 0.005.
+  // X = -0.32 + (height - 0.015 + 0.005) + 0.005. "height" is where the TCP sat on the book at the grasp from the
+  // shelf: its top (P1.x) plus grasp.offset_x_m (shipped -0.012: 12 mm below the top).
+  const double gx = settings().geometry.grasp_offset_x;
+  ASSERT_NEAR(gx, -0.012, 1e-12);
   const double ys[3] = {0.10 - 0.0125, 0.07 - 0.010, 0.045 - 0.015};
-  const double hs[3] = {0.25, 0.18, 0.22};
+  const double hs[3] = {0.25 + gx, 0.18 + gx, 0.22 + gx};
   for (int i = 0; i < 3; ++i) {
     const Eigen::Vector3d tcp = w.lower[i].second.translation();
     EXPECT_NEAR(tcp.x(), 0.60 - 0.01, 0.0015) << "book " << i;
@@ -165,13 +168,13 @@ TEST(LibraryCycle, ThreeBooksWholeCycleEveryTransitionAndPlacements) {
     EXPECT_NEAR(take.y(), drop.y(), 0.0015) << "book " << i;
     EXPECT_NEAR(take.z(), -0.09 + hs[i] + 0.005 - 0.015, 0.0015) << "book " << i;
   }
-  // Holder: support origin (0.301, 0.28, -0.09), base axes; TCP (-0.02, -0.24, h + 0.005) in it (coordinator.yaml
+  // Holder: support origin (0.301, 0.28, -0.09), base axes; TCP (-0.02, -0.24, hs + 0.005) in it (coordinator.yaml
   // holder.place_tcp_in_support_m: the fingers beyond the back plate's right edge).
   ASSERT_EQ(w.holder_drops.size(), 3u);
   const Eigen::Vector3d h0 = w.holder_drops[0].second.translation();
   EXPECT_NEAR(h0.x(), 0.281, 0.0015);
   EXPECT_NEAR(h0.y(), 0.04, 0.0015);
-  EXPECT_NEAR(h0.z(), -0.09 + 0.25 + 0.005, 0.0015);
+  EXPECT_NEAR(h0.z(), -0.09 + hs[0] + 0.005, 0.0015);
   // Gripper axes on the holder: x up (base z), y = base x (gripper_y_in_support), z = x cross y = base y.
   const Eigen::Matrix3d r = w.holder_drops[0].second.linear();
   EXPECT_NEAR(r(2, 0), 1.0, 0.02);
