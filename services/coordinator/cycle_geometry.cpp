@@ -46,7 +46,7 @@ CycleGeometry CycleGeometry::from_config(const Config& c) {
   g.plate_thickness = c.get_double("grasp.plate_thickness_m", 0.0, 0.05);
   g.left_plate_min_clearance = c.get_double("grasp.left_plate_min_clearance_m", 0.0, 0.05);
   g.more_than_the_book = c.get_double("grasp.more_than_the_book_m", 0.0, 0.05);
-  g.retry_left_clearance = c.get_double("grasp.retry_left_clearance_m", 0.0, 0.05);
+  g.retry_left_clearance = c.get_double("grasp.retry_left_clearance_m", 0.0005, 0.05);  // > 0: a narrower opening
   g.pre_grasp_distance = c.get_double("grasp.pre_grasp_distance_m", 0.01, 0.5);
   g.deep_front_z = c.get_double("grasp.deep_front_z_m", -0.2, 0.36);
   g.extract_lift = c.get_double("grasp.extract_lift_m", 0.0, 0.5);
@@ -166,7 +166,7 @@ PlateOpening plate_opening(const ForeEdges& edges, double open_width, const Cycl
 PlateOpening plate_opening_after_more_than_the_book(const ForeEdges& edges, double open_width, const CycleGeometry& g) {
   CycleGeometry narrow = g;
   narrow.left_plate_on_neighbour = false;
-  narrow.width_left_clearance = g.retry_left_clearance > 0 ? g.retry_left_clearance : 1e-9;
+  narrow.width_left_clearance = g.retry_left_clearance;
   return plate_opening(edges, open_width, narrow);
 }
 

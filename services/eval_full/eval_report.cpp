@@ -121,7 +121,8 @@ void write_report(const std::string& dir, const EvalMetrics& m, const std::strin
   md << "| grasp success | " << pct(m.grasp_successes, m.grasp_attempts) << " | 75 % (15/20) |\n";
   md << "| other books a grasp took out with the target (counted as failed grasps) | " << m.books_carried_along
      << " | - |\n";
-  md << "| books no grasp targeted that left the upper shelf | " << m.untargeted_books_off_the_upper_shelf << " | - |\n";
+  md << "| books no grasp targeted that left the upper shelf | " << m.untargeted_books_off_the_upper_shelf
+     << " | - |\n";
   md << "| books through the whole cycle | " << pct(m.books_moved, m.books_targeted) << " | - |\n";
   md << "| books left on the holder for the librarian: too tall for the lower shelf / not placeable there | "
      << m.books_handed_over - m.books_handed_over_unplaceable << " / " << m.books_handed_over_unplaceable << " | - |\n";

@@ -162,13 +162,15 @@ struct FullCycleHarness::Impl {
     Eigen::Vector3d in_tcp, in_base;
   };
   std::vector<OtherBookAtClose> others_at_close;
-  /// Books on the upper shelf other than `target_id`, where they sit now (TCP frame and base).
-  std::vector<OtherBookAtClose> other_books_now(const ground_truth_t& truth, int target_id) const {
+  /// Books other than `target_id` (with `upper_shelf_only`, those the truth has on the upper shelf), where they sit
+  /// now (TCP frame and base).
+  std::vector<OtherBookAtClose> other_books_now(const ground_truth_t& truth, int target_id,
+                                                bool upper_shelf_only) const {
     std::vector<OtherBookAtClose> out;
     const auto& model = sim->world().model();
     const int site = mj_name2id(model.model(), mjOBJ_SITE, "gripper");
     for (const auto& tb : truth.books) {
-      if (tb.id == target_id) continue;
+      if (tb.id == target_id || (upper_shelf_only && tb.place != "upper_shelf")) continue;
       const int body = mj_name2id(model.model(), mjOBJ_BODY, ("book_" + std::to_string(tb.id)).c_str());
       if (body < 0 || site < 0) continue;
       const Eigen::Vector3d c = body_pose(model.data(), body).translation();
@@ -180,7 +182,7 @@ struct FullCycleHarness::Impl {
   /// close and sit within 1 cm of where they sat in the TCP frame (lifted together with the target).
   std::vector<int> carried_along(const ground_truth_t& truth, int target_id) const {
     std::vector<int> ids;
-    const auto now = other_books_now(truth, target_id);
+    const auto now = other_books_now(truth, target_id, false);
     for (const auto& c : others_at_close)
       for (const auto& n : now)
         if (n.id == c.id && (n.in_base - c.in_base).norm() > 0.05 && (n.in_tcp - c.in_tcp).norm() < 0.01)
@@ -496,10 +498,7 @@ struct FullCycleHarness::Impl {
     if (in_extract && prev == "CLOSE_GRIPPER") {
       const int id = book(m->current_book).truth_id;
       book_in_tcp_at_close = book_in_tcp(id);
-      others_at_close.clear();
-      for (const auto& c : other_books_now(now_truth, id))
-        for (const auto& tb : now_truth.books)
-          if (tb.id == c.id && tb.place == "upper_shelf") others_at_close.push_back(c);
+      others_at_close = other_books_now(now_truth, id, true);
     }
     if (in_extract && prev == "EXTRACT") {
       in_extract = false;
@@ -522,8 +521,8 @@ struct FullCycleHarness::Impl {
         ++b.grasp_successes;
         ++res.grasp_successes;
       }
-      trace(std::string("GRASP ") + (held ? (along.empty() ? "held" : "held with other books: FAILED") : "FAILED") + ": book id " + std::to_string(b.truth_id) + " is " +
-            (tb ? tb->place : std::string("unknown")) +
+      trace(std::string("GRASP ") + (held ? (along.empty() ? "held" : "held with other books: FAILED") : "FAILED") +
+            ": book id " + std::to_string(b.truth_id) + " is " + (tb ? tb->place : std::string("unknown")) +
             (carried ? " (carried: it moved with the TCP since the close, one plate's contact off this instant)" : ""));
     } else if (in_extract && m->state != "EXTRACT" && m->state != "CLOSE_GRIPPER") {
       in_extract = false;  // the close itself failed (nothing grasped); counted as a failed attempt

@@ -42,8 +42,8 @@ struct EvalMetrics {
   int books_handed_over = 0;  ///< too tall for, or not placeable on, the lower shelf: left for the librarian
   int books_handed_over_unplaceable = 0;  ///< ... of them because the lower shelf could not take them
   int grasp_attempts = 0;
-  int grasp_successes = 0;                   ///< grasps that held the target and no other book
-  int books_carried_along = 0;               ///< other books a grasp took out of the shelf with the target
+  int grasp_successes = 0;      ///< grasps that held the target and no other book
+  int books_carried_along = 0;  ///< other books a grasp took out of the shelf with the target
   /// Books no grasp targeted that were not on the upper shelf at the end of their scene (lifted along, pushed off,
   /// knocked down by the arm).
   int untargeted_books_off_the_upper_shelf = 0;
@@ -79,9 +79,10 @@ std::vector<int> untargeted_books_off_the_upper_shelf(const FullCycleResult& r);
 /// Books the coordinator moved (TASK_STATUS books_moved) that the truth has on the lower shelf at the end.
 int books_on_lower_shelf(const FullCycleResult& r);
 
-/// The failure class of a scene ("" = none): ERROR, DOUBLE_LIFT (a grasp took other books along), BOOK_NOT_ON_HOLDER (a released book that the truth does not
-/// place on the holder: named before the abort it leads to), BOOK_NOT_ON_LOWER_SHELF (a book the coordinator
-/// moved that the truth does not have on the lower shelf), OTHER_BOOK_OFF_THE_UPPER_SHELF, ABORTED: <state>, BUDGET in <state>, GRASP_RETRIED, ...
+/// The failure class of a scene ("" = none): ERROR, DOUBLE_LIFT (a grasp took other books along), BOOK_NOT_ON_HOLDER (a
+/// released book that the truth does not place on the holder: named before the abort it leads to),
+/// BOOK_NOT_ON_LOWER_SHELF (a book the coordinator moved that the truth does not have on the lower shelf),
+/// OTHER_BOOK_OFF_THE_UPPER_SHELF, ABORTED: <state>, BUDGET in <state>, GRASP_RETRIED, ...
 std::string failure_reason(const FullCycleResult& r, int max_books);
 
 /// Accumulates `outcome` into `m` (max_books as given to the harness, 0 = all books).

@@ -467,13 +467,16 @@ TEST(LibraryCycle, BadDepthKeysNameTheKey) {
   std::stringstream ss;
   ss << f.rdbuf();
   const std::string shipped = ss.str();
-  for (const auto& [key, line, bad] : {std::tuple<std::string, std::string, std::string>{
-                                           "grasp.deep_front_z_m", "deep_front_z_m: 0.035", "deep_front_z_m: 0.9"},
-                                       {"servo.book_front_z_m", "book_front_z_m: 0.01", "book_front_z_m: 0.5"},
-                                       // Right of position A (Y 0.30): the servo would stop before it starts.
-                                       {"servo.stripe_left_limit_y_m", "stripe_left_limit_y_m: -0.15",
-                                        "stripe_left_limit_y_m: 0.35"},
-                                       {"limit_stop_place_m", "limit_stop_place_m: 0.02", "limit_stop_place_m: 0.2"}}) {
+  for (const auto& [key, line, bad] :
+       {std::tuple<std::string, std::string, std::string>{"grasp.deep_front_z_m", "deep_front_z_m: 0.035",
+                                                          "deep_front_z_m: 0.9"},
+        {"servo.book_front_z_m", "book_front_z_m: 0.01", "book_front_z_m: 0.5"},
+        // Right of position A (Y 0.30): the servo would stop before it starts.
+        {"servo.stripe_left_limit_y_m", "stripe_left_limit_y_m: -0.15", "stripe_left_limit_y_m: 0.35"},
+        {"limit_stop_place_m", "limit_stop_place_m: 0.02", "limit_stop_place_m: 0.2"},
+        // The plate-distance check: 0 would leave the retry as wide as the grasp.
+        {"grasp.retry_left_clearance_m", "retry_left_clearance_m: 0.005", "retry_left_clearance_m: 0.0"},
+        {"grasp.more_than_the_book_m", "more_than_the_book_m: 0.007", "more_than_the_book_m: 0.2"}}) {
     std::string text = shipped;
     const auto pos = text.find(line);
     ASSERT_NE(pos, std::string::npos) << line;
