@@ -1,0 +1,173 @@
+#include "services/eval_full/scene_record.h"
+
+#include <yaml-cpp/yaml.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
+
+namespace bookgrasp {
+
+namespace {
+
+/// The integer counts of EvalMetrics by their YAML key.
+template <typename M>
+auto counts(M& m) {
+  return std::vector<std::pair<const char*, decltype(&m.scenes)>>{
+      {"scenes", &m.scenes},
+      {"books_targeted", &m.books_targeted},
+      {"books_moved", &m.books_moved},
+      {"books_handed_over", &m.books_handed_over},
+      {"books_handed_over_unplaceable", &m.books_handed_over_unplaceable},
+      {"grasp_attempts", &m.grasp_attempts},
+      {"grasp_successes", &m.grasp_successes},
+      {"books_carried_along", &m.books_carried_along},
+      {"untargeted_books_off_the_upper_shelf", &m.untargeted_books_off_the_upper_shelf},
+      {"holder_releases", &m.holder_releases},
+      {"holder_placed", &m.holder_placed},
+      {"holder_retreats", &m.holder_retreats},
+      {"holder_standing", &m.holder_standing},
+      {"decisions", &m.decisions},
+      {"decisions_agreeing", &m.decisions_agreeing},
+      {"widths", &m.widths},
+      {"widths_within", &m.widths_within},
+  };
+}
+
+/// The samples of EvalMetrics by their YAML key.
+template <typename M>
+auto samples(M& m) {
+  return std::vector<std::pair<const char*, decltype(&m.cycle_s)>>{
+      {"width_error_mm", &m.width_error_mm},
+      {"p1_error_mm_x", &m.p1_error_mm[0]},
+      {"p1_error_mm_y", &m.p1_error_mm[1]},
+      {"p1_error_mm_z", &m.p1_error_mm[2]},
+      {"gp_error_mm_x", &m.gp_error_mm[0]},
+      {"gp_error_mm_y", &m.gp_error_mm[1]},
+      {"gp_error_mm_z", &m.gp_error_mm[2]},
+      {"gp_base_error_mm_x", &m.gp_base_error_mm[0]},
+      {"gp_base_error_mm_y", &m.gp_base_error_mm[1]},
+      {"gp_base_error_mm_z", &m.gp_base_error_mm[2]},
+      {"p1_p2_dy_mm", &m.p1_p2_dy_mm},
+      {"p1_p2_dx_mm", &m.p1_p2_dx_mm},
+      {"cycle_s", &m.cycle_s},
+      {"plan_ms", &m.plan_ms},
+      {"scene_wall_s", &m.scene_wall_s},
+  };
+}
+
+std::string exact(double v) {
+  char b[40];
+  std::snprintf(b, sizeof b, "%.17g", v);
+  return b;
+}
+
+YAML::Node required(const YAML::Node& n, const std::string& key, const std::string& where) {
+  const YAML::Node v = n[key];
+  if (!v) throw std::runtime_error(where + ": key '" + key + "' is missing (not a scene record of this version?)");
+  return v;
+}
+
+}  // namespace
+
+std::string scene_record_yaml(const SceneRecord& r) {
+  YAML::Emitter e;
+  e << YAML::BeginMap;
+  e << YAML::Key << "seed" << YAML::Value << r.seed;
+  e << YAML::Key << "options" << YAML::Value << YAML::DoubleQuoted << r.options;
+  e << YAML::Key << "books_per_scene" << YAML::Value << r.books_per_scene;
+  e << YAML::Key << "csv_row" << YAML::Value << YAML::DoubleQuoted << r.csv_row;
+  for (const auto& [key, v] : counts(r.metrics)) e << YAML::Key << key << YAML::Value << *v;
+  for (const auto& [key, v] : samples(r.metrics)) {
+    e << YAML::Key << key << YAML::Value << YAML::Flow << YAML::BeginSeq;
+    for (double x : *v) e << YAML::Value << exact(x);
+    e << YAML::EndSeq;
+  }
+  e << YAML::Key << "failures" << YAML::Value << YAML::BeginSeq;
+  for (const auto& [seed, why] : r.metrics.failures)
+    e << YAML::Flow << YAML::BeginMap << YAML::Key << "seed" << YAML::Value << seed << YAML::Key << "reason"
+      << YAML::Value << YAML::DoubleQuoted << why << YAML::EndMap;
+  e << YAML::EndSeq;
+  e << YAML::Key << "failure_modes" << YAML::Value << YAML::BeginMap;
+  for (const auto& [why, n] : r.metrics.failure_modes) e << YAML::Key << YAML::DoubleQuoted << why << YAML::Value << n;
+  e << YAML::EndMap;
+  e << YAML::EndMap;
+  return std::string(e.c_str()) + "\n";
+}
+
+SceneRecord parse_scene_record(const std::string& text, const std::string& where) {
+  SceneRecord r;
+  try {
+    const YAML::Node n = YAML::Load(text);
+    if (!n.IsMap()) throw std::runtime_error(where + ": not a YAML map");
+    r.seed = required(n, "seed", where).as<uint64_t>();
+    r.options = required(n, "options", where).as<std::string>();
+    r.books_per_scene = required(n, "books_per_scene", where).as<int>();
+    r.csv_row = required(n, "csv_row", where).as<std::string>();
+    for (const auto& [key, v] : counts(r.metrics)) *v = required(n, key, where).as<int>();
+    for (const auto& [key, v] : samples(r.metrics)) *v = required(n, key, where).as<std::vector<double>>();
+    for (const auto& f : required(n, "failures", where))
+      r.metrics.failures.emplace_back(required(f, "seed", where).as<uint64_t>(),
+                                      required(f, "reason", where).as<std::string>());
+    for (const auto& kv : required(n, "failure_modes", where))
+      r.metrics.failure_modes[kv.first.as<std::string>()] = kv.second.as<int>();
+  } catch (const YAML::Exception& e) {
+    throw std::runtime_error(where + ": " + e.what());
+  }
+  return r;
+}
+
+std::map<uint64_t, SceneRecord> read_scene_records(const std::string& dir) {
+  std::map<uint64_t, SceneRecord> out;
+  const std::filesystem::path scenes = std::filesystem::path(dir) / "scenes";
+  if (!std::filesystem::is_directory(scenes)) return out;
+  for (const auto& f : std::filesystem::directory_iterator(scenes)) {
+    const std::string name = f.path().filename().string();
+    if (name.rfind("seed_", 0) != 0 || f.path().extension() != ".yaml") continue;
+    std::ifstream in(f.path());
+    std::stringstream text;
+    text << in.rdbuf();
+    SceneRecord r = parse_scene_record(text.str(), f.path().string());
+    const uint64_t seed = r.seed;
+    out.emplace(seed, std::move(r));
+  }
+  return out;
+}
+
+std::map<uint64_t, SceneRecord> merged_scene_records(const std::vector<std::string>& dirs) {
+  std::map<uint64_t, SceneRecord> all;
+  std::map<uint64_t, std::string> where;
+  for (const auto& d : dirs) {
+    auto records = read_scene_records(d);
+    if (records.empty()) throw std::runtime_error(d + " holds no scenes/seed_*.yaml");
+    for (auto& [seed, r] : records) {
+      if (!all.empty() && r.options != all.begin()->second.options)
+        throw std::runtime_error("seed " + std::to_string(seed) + " in " + d + " ran with other options:\n  " +
+                                 r.options + "\nnot\n  " + all.begin()->second.options);
+      if (all.count(seed))
+        throw std::runtime_error("seed " + std::to_string(seed) + " is in both " + where[seed] + " and " + d);
+      where[seed] = d;
+      all.emplace(seed, std::move(r));
+    }
+  }
+  return all;
+}
+
+void add_metrics(const EvalMetrics& from, EvalMetrics* into) {
+  const auto src = counts(from);
+  const auto dst = counts(*into);
+  for (size_t i = 0; i < dst.size(); ++i) *dst[i].second += *src[i].second;
+  const auto ssrc = samples(from);
+  const auto sdst = samples(*into);
+  for (size_t i = 0; i < sdst.size(); ++i)
+    sdst[i].second->insert(sdst[i].second->end(), ssrc[i].second->begin(), ssrc[i].second->end());
+  into->failures.insert(into->failures.end(), from.failures.begin(), from.failures.end());
+  std::stable_sort(into->failures.begin(), into->failures.end(),
+                   [](const auto& a, const auto& b) { return a.first < b.first; });
+  for (const auto& [why, n] : from.failure_modes) into->failure_modes[why] += n;
+}
+
+}  // namespace bookgrasp
