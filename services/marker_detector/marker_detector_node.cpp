@@ -245,8 +245,9 @@ void MarkerDetectorNode::range_in_stereo(const stereo_frame_t& frame, const cv::
       return;
     }
   }
-  const TagStereoRange r = range_tag_in_stereo(left_gray, *right_gray, d.corners, k.fx, k.cx,
-                                               frame.right_calibration.cx, frame.baseline_m, settings_.stereo_range);
+  const TagStereoRange r =
+      range_tag_in_stereo(left_gray, *right_gray, d.corners, k.fx, k.cx, frame.right_calibration.cx, frame.baseline_m,
+                          settings_.stereo_range, pose->tag_in_camera.translation().z());
   if (!r.ok) {
     report_error(what + ": no stereo range: " + r.reason + " (monocular pose)");
     return;

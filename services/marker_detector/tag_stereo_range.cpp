@@ -20,7 +20,7 @@ TagStereoRangeParams TagStereoRangeParams::from_config(const Config& c) {
 
 TagStereoRange range_tag_in_stereo(const cv::Mat& left, const cv::Mat& right, const std::array<cv::Point2d, 4>& corners,
                                    double fx, double cx_left, double cx_right, double baseline_m,
-                                   const TagStereoRangeParams& p) {
+                                   const TagStereoRangeParams& p, double monocular_depth_m) {
   TagStereoRange r;
   if (left.type() != CV_8UC1 || right.type() != CV_8UC1 || left.size() != right.size()) {
     r.reason = "the stereo pair must be two grey images of one size";
@@ -53,7 +53,21 @@ TagStereoRange range_tag_in_stereo(const cv::Mat& left, const cv::Mat& right, co
   const int first_col = std::max(0, patch.x - max_shift);
   const int min_shift = std::max(0, static_cast<int>(std::floor(-offset)) - 1);
   const int last_col = patch.x - min_shift;  // left edge of the patch's position in the right image
+  // Where the monocular depth puts the patch's left edge in the right image: left of column 0, no match can be
+  // found, and the message says so rather than blaming the match.
+  const double expected_col = patch.x - (fx * baseline_m / monocular_depth_m - offset);
+  const auto outside_right = [&]() {
+    if (!(monocular_depth_m > 0) || !(expected_col < 0)) return false;
+    char b[200];
+    std::snprintf(b, sizeof b,
+                  "the tag is outside the right image: at its monocular depth %.2f m, its patch would start at column "
+                  "%.0f",
+                  monocular_depth_m, expected_col);
+    r.reason = b;
+    return true;
+  };
   if (last_col - first_col < 2) {
+    if (outside_right()) return r;
     r.reason = "no room to search the right image (the tag is at its left edge)";
     return r;
   }
@@ -65,6 +79,7 @@ TagStereoRange range_tag_in_stereo(const cv::Mat& left, const cv::Mat& right, co
   cv::minMaxLoc(score, nullptr, &best_score, nullptr, &best);
   r.score = best_score;
   if (!(best_score >= p.min_score)) {
+    if (outside_right()) return r;
     char b[160];
     std::snprintf(b, sizeof b, "the tag's patch matches the right image at %.2f only (stereo_range.min_score %.2f)",
                   best_score, p.min_score);

@@ -41,10 +41,12 @@ struct TagStereoRange {
 
 /// Ranges the tag with corners `corners` (left image) in the rectified pair (CV_8UC1, same size). `fx` is the
 /// focal length in pixels, `cx_left` / `cx_right` the principal points' columns, `baseline_m` the right optical
-/// centre's distance along the left camera's +x.
+/// centre's distance along the left camera's +x. `monocular_depth_m` (> 0 when known) only names the cause when no
+/// match is found: a tag whose monocular depth puts it (partly) outside the right image.
 TagStereoRange range_tag_in_stereo(const cv::Mat& left_gray, const cv::Mat& right_gray,
                                    const std::array<cv::Point2d, 4>& corners, double fx, double cx_left,
-                                   double cx_right, double baseline_m, const TagStereoRangeParams& params);
+                                   double cx_right, double baseline_m, const TagStereoRangeParams& params,
+                                   double monocular_depth_m = 0);
 
 /// `tag_in_camera` slid along the ray through its origin so the origin's depth (camera z) is `depth_m`;
 /// orientation unchanged.

@@ -96,6 +96,22 @@ TEST(TagStereoRange, SlidingThePoseToADepthKeepsItsRayAndOrientation) {
   EXPECT_TRUE(s.linear().isApprox(t.linear(), 1e-12));
 }
 
+TEST(TagStereoRange, ATagOutsideTheRightImageIsNamedSo) {
+  // 0.7 m away, 87 px from the left image's left edge: the right camera (0.12 m to the right) sees it 107 px further
+  // left, i.e. cut by its left border (far_cart's holder tag).
+  const Pair p = draw_pair(tag_at(-0.26, 0.0, 0.7, 0));
+  const TagStereoRange r = range_tag_in_stereo(p.left, p.right, p.corners, kFx, kCx, kCx, kBaseline, {}, 0.7);
+  EXPECT_FALSE(r.ok);
+  EXPECT_NE(r.reason.find("outside the right image: at its monocular depth 0.70 m"), std::string::npos) << r.reason;
+  // Without the monocular depth the same failure is a poor match, as before.
+  const TagStereoRange unknown = range_tag_in_stereo(p.left, p.right, p.corners, kFx, kCx, kCx, kBaseline, {});
+  EXPECT_FALSE(unknown.ok);
+  EXPECT_EQ(unknown.reason.find("outside the right image"), std::string::npos) << unknown.reason;
+  // A tag well inside both images is ranged with its monocular depth given too.
+  const Pair inside = draw_pair(tag_at(0.1, 0.0, 0.7, 0));
+  EXPECT_TRUE(range_tag_in_stereo(inside.left, inside.right, inside.corners, kFx, kCx, kCx, kBaseline, {}, 0.7).ok);
+}
+
 TEST(TagStereoRange, InputsItCannotRangeAreRefusedWithAReason) {
   const Pair p = draw_pair(tag_at(0.0, 0.0, 1.6, 0));
   const TagStereoRangeParams d;
