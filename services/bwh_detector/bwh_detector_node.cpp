@@ -49,7 +49,7 @@ bool decode_hand_image(const hand_image_t& msg, cv::Mat* image, std::string* rea
 }
 
 BwhDetectorNode::BwhDetectorNode(const BwhDetectorSettings& settings)
-    : Component("bwh_detector", "canny_regions"), settings_(settings) {
+    : Component("bwh_detector", settings.method), settings_(settings) {
   subscribe(settings_.input_channel, &BwhDetectorNode::on_image);
   subscribe(settings_.servo_request_channel, &BwhDetectorNode::on_request);
 }

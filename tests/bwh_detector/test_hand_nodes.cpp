@@ -225,5 +225,13 @@ TEST(HandConfigs, ShippedFilesAreCompleteAndValid) {
   }
 }
 
+TEST(HandConfigs, TheStatusNamesTheMethodInUse) {
+  // SERVICE_STATUS.implementation (the monitor's table, lcm-spy) is the detection method the node runs.
+  BwhDetectorSettings s = BwhDetectorSettings::from_config(Config::load_file(kConfigDir + "bwh_detector.yaml"));
+  EXPECT_EQ(BwhDetectorNode(s).implementation(), "page_faces");
+  s.method = "canny_regions";
+  EXPECT_EQ(BwhDetectorNode(s).implementation(), "canny_regions");
+}
+
 }  // namespace
 }  // namespace bookgrasp
