@@ -61,6 +61,8 @@ constexpr const char* kRobotContact = "contype=\"2\" conaffinity=\"1\"";
 // Books and static geoms collide with books and the robot.
 constexpr const char* kSceneContact = "contype=\"1\" conaffinity=\"3\"";
 constexpr const char* kVisualOnly = "contype=\"0\" conaffinity=\"0\"";
+/// A marker plate's depth from its face back into its mount (the mounts are 15-20 mm thick).
+constexpr double kMarkerPlateDepth = 0.011;
 
 class RobotWriter {
  public:
@@ -256,12 +258,14 @@ MjcfDocument build_mjcf(const Scene& s) {
       << " 0.005 0.0001\"/>\n";
   }
   for (const Marker* mk : {&s.cart_marker, &s.holder_marker}) {
-    // Plate with the white border (10 cells for 8 black cells), 1 mm thick, back face on the mount.
+    // Plate with the white border (10 cells for 8 black cells): its face 1 mm proud of the mount, its back
+    // kMarkerPlateDepth behind that face, inside the mount (visual only). A 1 mm plate shadowed itself: the
+    // shadow map's depth of its back face was within a texel's depth slope of the face, and the white cells
+    // rendered as a 1-px dark checker that AprilTag misses (far_cart seed 5250's cart tag).
     const double half = mk->size_m * 10.0 / 8.0 / 2.0;
-    const Eigen::Isometry3d p = mk->pose * Eigen::Translation3d(0, 0, -0.0005 + 0.0005);
-    x << "    <geom name=\"" << mk->name << "\" type=\"box\" size=\"" << num(half) << " " << num(half)
-      << " 0.0005\" " << pose_attr(p * Eigen::Translation3d(0, 0, -0.0005)) << " material=\"" << mk->name
-      << "_mat\" " << kVisualOnly << "/>\n";
+    x << "    <geom name=\"" << mk->name << "\" type=\"box\" size=\"" << num(half) << " " << num(half) << " "
+      << num(kMarkerPlateDepth / 2) << "\" " << pose_attr(mk->pose * Eigen::Translation3d(0, 0, -kMarkerPlateDepth / 2))
+      << " material=\"" << mk->name << "_mat\" " << kVisualOnly << "/>\n";
   }
   // Stereo cameras: MuJoCo camera axes = optical (x right, y down, z forward) turned by pi about x.
   const Eigen::Matrix3d flip = Eigen::Vector3d(1, -1, -1).asDiagonal();

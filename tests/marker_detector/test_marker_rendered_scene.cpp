@@ -1,10 +1,12 @@
 // The marker detector on rendered stereo frames of the simulated library, against the simulation's truth:
-// the cart tag whose aliased edges the first pass misses is found by the blurred second pass, upright
-// and where the truth puts it.
+// the first pass finds the cart tag in every scene; a noisy one it misses is found by the blurred second pass,
+// upright and where the truth puts it.
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cstdio>
+
+#include <opencv2/core.hpp>
 
 #include "common/image_conversion.h"
 #include "common/pose_conversion.h"
@@ -44,14 +46,32 @@ std::optional<marker_t> cart_marker(const MarkerDetectorSettings& s, const stere
   return std::nullopt;
 }
 
+// Until 2026-12-04 the tag plates were 1 mm thick and shadowed themselves: the white cells rendered as a 1-px dark
+// checker, which the first pass missed (seed 7 among others) and which put the monocular pose ~2 cm off. The plate
+// now reaches 11 mm into its mount (common/scene/mjcf_builder.cpp) and the first pass finds every cart tag here.
+TEST(MarkerRenderedScene, TheFirstPassFindsTheCartTagInEveryScene) {
+  MarkerDetectorSettings first_pass_only = MarkerDetectorSettings::from_config(
+      Config::load_file(std::string(BOOKGRASP_SOURCE_DIR) + "/config/services/marker_detector.yaml"));
+  first_pass_only.fallback_quad_sigma = 0.0;
+  for (uint64_t seed = 1; seed <= 10; ++seed)
+    EXPECT_TRUE(cart_marker(first_pass_only, render(seed).frame).has_value()) << "far_cart seed " << seed;
+}
+
 TEST(MarkerRenderedScene, TheFallbackPassFindsTheCartTagTheFirstPassMisses) {
   const MarkerDetectorSettings shipped = MarkerDetectorSettings::from_config(
       Config::load_file(std::string(BOOKGRASP_SOURCE_DIR) + "/config/services/marker_detector.yaml"));
   ASSERT_GT(shipped.fallback_quad_sigma, 0.0);
   MarkerDetectorSettings first_pass_only = shipped;
   first_pass_only.fallback_quad_sigma = 0.0;
-  // far_cart seed 7: the first pass misses the cart tag (docs/HAND_CAMERA.md).
-  const Rendered r = render(7);
+  // far_cart seed 8 under strong sensor noise (Gaussian, 50 grey levels): the first pass misses the cart tag.
+  Rendered r = render(8);
+  cv::Mat rgb = image_to_mat(r.frame.left), noise(rgb.size(), CV_32FC3), noisy;
+  cv::RNG rng(8);
+  rng.fill(noise, cv::RNG::NORMAL, 0, 50.0);
+  rgb.convertTo(noisy, CV_32FC3);
+  noisy += noise;
+  noisy.convertTo(rgb, CV_8UC3);
+  r.frame.left = mat_to_image(rgb, image_t::RGB8, r.frame.left.utime, r.frame.left.frame);
   EXPECT_FALSE(cart_marker(first_pass_only, r.frame).has_value());
   const std::optional<marker_t> m = cart_marker(shipped, r.frame);
   ASSERT_TRUE(m.has_value());
@@ -79,9 +99,10 @@ Rendered render_pair(uint64_t seed) {
   return r;
 }
 
-// The cart tag is ~30 px at 1.6 m: its monocular pose is a few cm off along the view (far_cart seed 1: 21 mm,
-// which every grasp point inherited through the cart frame, docs/EVALUATION.md). Ranged by its disparity it is
-// within 8 mm of the truth in every scene; the monocular errors are printed for comparison.
+// The cart tag is ~30 px at 1.6 m. On the self-shadowed plates of before 2026-12-04 its monocular pose was a few cm
+// off along the view (far_cart seed 1: 21 mm, which every grasp point inherited through the cart frame,
+// docs/EVALUATION.md), and the disparity's range fixed that. On the clean plates both are within 8 mm of the truth
+// in every scene; the monocular pose is now the closer one (seeds 1-6: 1.6-2.2 mm against 3.1-3.9 mm), printed here.
 TEST(MarkerRenderedScene, TheStereoRangedCartTagIsWithinEightMillimetresOfTheTruth) {
   const MarkerDetectorSettings shipped = MarkerDetectorSettings::from_config(
       Config::load_file(std::string(BOOKGRASP_SOURCE_DIR) + "/config/services/marker_detector.yaml"));
@@ -101,15 +122,16 @@ TEST(MarkerRenderedScene, TheStereoRangedCartTagIsWithinEightMillimetresOfTheTru
     std::printf("far_cart seed %d: cart tag %.1f mm off with the stereo range, %.1f mm monocular\n",
                 static_cast<int>(seed), es * 1e3, em * 1e3);
     EXPECT_LT(es, 0.008) << "seed " << seed << " (monocular: " << em * 1e3 << " mm)";
+    EXPECT_LT(em, 0.008) << "seed " << seed << " monocular";
     worst_mono = std::max(worst_mono, em);
     worst_stereo = std::max(worst_stereo, es);
   }
-  EXPECT_GE(found, 4) << "the cart tag was found in too few scenes to judge";
-  EXPECT_LT(worst_stereo, worst_mono) << "the stereo range did not improve on the monocular pose";
+  EXPECT_EQ(found, 6) << "the cart tag is found in every one of these scenes (TheFirstPassFinds...)";
+  std::printf("worst: %.1f mm with the stereo range, %.1f mm monocular\n", worst_stereo * 1e3, worst_mono * 1e3);
 }
 
-// The next frames (same view, 10 Hz) are searched only in regions around the tags found: the cart tag,
-// found by the blurred pass, is found there again (blurred pass on the region) at the same pose.
+// The next frames (same view, 10 Hz) are searched only in regions around the tags found: the cart tag
+// is found there again at the same pose.
 TEST(MarkerRenderedScene, TheCartTagIsFoundAgainInItsRegionOnTheNextFrames) {
   const MarkerDetectorSettings shipped = MarkerDetectorSettings::from_config(
       Config::load_file(std::string(BOOKGRASP_SOURCE_DIR) + "/config/services/marker_detector.yaml"));
