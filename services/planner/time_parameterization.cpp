@@ -7,6 +7,11 @@
 namespace bookgrasp {
 namespace {
 
+/// Samples closer than this in time are not both kept: trajectory messages carry microseconds, and two samples
+/// less than half a microsecond apart got the same utime, which the arm driver refuses ("times must increase
+/// strictly", seen once in a composed run, default.yaml seed 5).
+constexpr double kMinSampleGapS = 1e-5;
+
 /// Trapezoidal profile of s from 0 to 1 with peak speed v and acceleration a.
 struct Profile {
   double v = 0, a = 0, t_acc = 0, t_total = 0;
@@ -68,10 +73,15 @@ TimedTrajectory parameterize_trapezoidal(const std::vector<Eigen::VectorXd>& way
       as = std::min(as, max_acceleration[j] / adq[j]);
     }
     const Profile p(vs, as);
-    // Samples on the global grid strictly inside the segment, then the segment end exactly.
+    if (p.t_total < kMinSampleGapS) {  // a step of ~1e-10 rad: the previous point takes this waypoint
+      out.points.back().position = waypoints[k];
+      continue;
+    }
+    // Samples on the global grid strictly inside the segment (at least kMinSampleGapS from both ends), then the
+    // segment end exactly.
     double t_next = std::ceil(t0 / sample_period_s + 1e-9) * sample_period_s;
-    if (t_next <= t0 + 1e-9) t_next += sample_period_s;
-    for (; t_next < t0 + p.t_total - 1e-9; t_next += sample_period_s) {
+    if (t_next <= t0 + kMinSampleGapS) t_next += sample_period_s;
+    for (; t_next < t0 + p.t_total - kMinSampleGapS; t_next += sample_period_s) {
       double s, sd, sdd;
       p.eval(t_next - t0, s, sd, sdd);
       out.points.push_back({t_next, waypoints[k - 1] + s * dq, sd * dq, sdd * dq});

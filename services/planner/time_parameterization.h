@@ -28,7 +28,7 @@ struct TimedTrajectory {
 
 /// The trajectory through `waypoints` (at least one; all of the same size
 /// as the limits), sampled every `sample_period_s` plus exactly at every
-/// waypoint. Zero-length segments are skipped. Throws std::invalid_argument
+/// waypoint. Zero-length segments are skipped; samples are at least 10 us apart (messages carry microseconds). Throws std::invalid_argument
 /// for mismatched sizes, non-positive limits or period.
 TimedTrajectory parameterize_trapezoidal(const std::vector<Eigen::VectorXd>& waypoints,
                                          const Eigen::VectorXd& max_velocity,

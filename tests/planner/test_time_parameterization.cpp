@@ -100,5 +100,22 @@ TEST(TimeParameterization, BadInputsThrow) {
   EXPECT_THROW(parameterize_trapezoidal({Eigen::VectorXd::Zero(3)}, v2(1, 1), v2(1, 1), 0.01), std::invalid_argument);
 }
 
+TEST(TimeParameterization, SamplesStayApartInWholeMicroseconds) {
+  // A triangle of T = 2 sqrt(d / a) = 0.1 s + 0.3 us (a = 1, d = (0.05 + 1.5e-7)^2): the grid sample at 0.1 s lies
+  // 0.3 us before the segment's end. Trajectory messages carry microseconds, so both became utime 100000 and the arm
+  // driver refused the command. The sample is dropped; the end is kept exactly.
+  const double d = std::pow(0.05 + 1.5e-7, 2);
+  const TimedTrajectory t = parameterize_trapezoidal({v2(0, 0), v2(d, 0), v2(d, 0.01)}, v2(10, 10), v2(1, 1), 0.01);
+  EXPECT_NEAR(t.points.back().position[0], d, 1e-15);
+  EXPECT_NEAR(t.points.back().position[1], 0.01, 1e-15);
+  for (size_t k = 1; k < t.points.size(); ++k)
+    EXPECT_GT(std::llround(t.points[k].time_s * 1e6), std::llround(t.points[k - 1].time_s * 1e6))
+        << "samples " << k - 1 << " and " << k << " at " << t.points[k - 1].time_s << " and " << t.points[k].time_s;
+  // A step of 1e-11 rad (a planner's "repeated" waypoint that is not quite one) adds no sample of its own.
+  const TimedTrajectory tiny = parameterize_trapezoidal({v2(0, 0), v2(1e-11, 0)}, v2(1, 1), v2(2, 2), 0.01);
+  ASSERT_EQ(tiny.points.size(), 1u);
+  EXPECT_EQ(tiny.points.back().position[0], 1e-11);
+}
+
 }  // namespace
 }  // namespace bookgrasp
