@@ -2,8 +2,8 @@
 // hand below from the geometry of the default scene, not taken from the code.
 //
 // Cart marker (AprilTag frame: x right as seen from the robot, y down, z into the board) at base
-// (0.959, 0.25, 0.37), facing the robot: x_t = -y_base, y_t = -z_base, z_t = +x_base. With
-// grasp_origin_in_marker_m = (-0.37, 0.30, -0.359) the grasp frame is X = +z_base, Y = -y_base,
+// (0.959, 0.15, 0.37), facing the robot: x_t = -y_base, y_t = -z_base, z_t = +x_base. With
+// grasp_origin_in_marker_m = (-0.37, 0.20, -0.359) the grasp frame is X = +z_base, Y = -y_base,
 // Z = +x_base, origin (0.60, -0.05, 0.0) (the cart origin of config/scenes/default.yaml), so
 //     p_grasp = (z_b, -(y_b + 0.05), x_b - 0.60)   and   p_base = (0.60 + Z, -0.05 - Y, X).
 #include "services/arbiter/arbiter_node.h"
@@ -51,7 +51,7 @@ marker_detections_t markers(int64_t utime) {
   t.linear().col(0) = Eigen::Vector3d(0, -1, 0);
   t.linear().col(1) = Eigen::Vector3d(0, 0, -1);
   t.linear().col(2) = Eigen::Vector3d(1, 0, 0);
-  t.translation() = Eigen::Vector3d(0.959, 0.25, 0.37);
+  t.translation() = Eigen::Vector3d(0.959, 0.15, 0.37);
   marker_t m;
   m.utime = utime;
   m.family = "tag36h11";

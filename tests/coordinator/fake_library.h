@@ -42,13 +42,13 @@ inline Eigen::Isometry3d hand_grasp_frame() {
   return g;
 }
 
-/// Cart marker of the default scene (AprilTag axes), base (0.959, 0.25, 0.37), facing the robot.
+/// Cart marker of the default scene (AprilTag axes), base (0.959, 0.15, 0.37), facing the robot.
 inline Eigen::Isometry3d cart_marker_pose() {
   Eigen::Isometry3d t = Eigen::Isometry3d::Identity();
   t.linear().col(0) = Eigen::Vector3d(0, -1, 0);
   t.linear().col(1) = Eigen::Vector3d(0, 0, -1);
   t.linear().col(2) = Eigen::Vector3d(1, 0, 0);
-  t.translation() = Eigen::Vector3d(0.959, 0.25, 0.37);
+  t.translation() = Eigen::Vector3d(0.959, 0.15, 0.37);
   return t;
 }
 
