@@ -24,16 +24,6 @@
 
 namespace {
 
-/// "A,B,C" -> {A, B, C}; throws when it names no channel.
-std::vector<std::string> channel_list(const std::string& text) {
-  std::vector<std::string> out;
-  std::stringstream list(text);
-  for (std::string c; std::getline(list, c, ',');)
-    if (!c.empty()) out.push_back(c);
-  if (out.empty()) throw std::invalid_argument("--log-channels needs at least one channel name");
-  return out;
-}
-
 void usage(std::ostream& os) {
   os << "usage: bookgrasp_eval_full --scenes N --seed S --out DIR [options]\n"
         "  N seeded scenes (seeds S, S+1, ..., S+N-1) through the whole library cycle in one process.\n"
@@ -60,12 +50,19 @@ void usage(std::ostream& os) {
         "  different seeds; the figures are those of one run over all of them.\n";
 }
 
-/// "A,B,C" -> {A, B, C}.
+/// "A,B,C" -> {A, B, C} (empty items dropped).
 std::vector<std::string> comma_list(const std::string& text) {
   std::vector<std::string> out;
   std::stringstream list(text);
   for (std::string c; std::getline(list, c, ',');)
     if (!c.empty()) out.push_back(c);
+  return out;
+}
+
+/// --log-channels' list; throws when it names no channel.
+std::vector<std::string> channel_list(const std::string& text) {
+  std::vector<std::string> out = comma_list(text);
+  if (out.empty()) throw std::invalid_argument("--log-channels needs at least one channel name");
   return out;
 }
 
@@ -159,8 +156,10 @@ int main(int argc, char** argv) {
       else if (a == "--verbose") verbose = true;
       else if (a == "--resume")
         resume = true;
-      else if (a == "--merge")
+      else if (a == "--merge") {
         merge = comma_list(value());
+        if (merge.empty()) throw std::invalid_argument("--merge needs at least one directory");
+      }
       else throw std::invalid_argument("unknown argument " + a);
     }
     if (!merge.empty()) {
