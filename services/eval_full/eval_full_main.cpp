@@ -159,8 +159,8 @@ int main(int argc, char** argv) {
       else if (a == "--merge") {
         merge = comma_list(value());
         if (merge.empty()) throw std::invalid_argument("--merge needs at least one directory");
-      }
-      else throw std::invalid_argument("unknown argument " + a);
+      } else
+        throw std::invalid_argument("unknown argument " + a);
     }
     if (!merge.empty()) {
       if (out.empty()) throw std::invalid_argument("--merge needs --out DIR");
