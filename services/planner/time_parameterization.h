@@ -28,8 +28,8 @@ struct TimedTrajectory {
 
 /// The trajectory through `waypoints` (at least one; all of the same size
 /// as the limits), sampled every `sample_period_s` plus exactly at every
-/// waypoint. Zero-length segments are skipped; samples are at least 10 us apart (messages carry microseconds). Throws std::invalid_argument
-/// for mismatched sizes, non-positive limits or period.
+/// waypoint. Zero-length segments are skipped; samples are at least 10 us apart (messages carry microseconds). Throws
+/// std::invalid_argument for mismatched sizes, non-positive limits or period.
 TimedTrajectory parameterize_trapezoidal(const std::vector<Eigen::VectorXd>& waypoints,
                                          const Eigen::VectorXd& max_velocity,
                                          const Eigen::VectorXd& max_acceleration, double sample_period_s);
