@@ -34,7 +34,8 @@ struct Stats {
 /// Statistics of `v` (all zero when empty).
 Stats stats_of(std::vector<double> v);
 
-/// Everything metrics.json carries.
+/// Everything metrics.json carries. A new field must also be listed in scene_record.cpp (counts() or samples()), or
+/// resumed and merged runs lose it.
 struct EvalMetrics {
   int scenes = 0;
   int books_targeted = 0;                    ///< books the cycle was asked to move (per scene: max_books or all)
