@@ -47,6 +47,9 @@ CycleGeometry CycleGeometry::from_config(const Config& c) {
   g.left_plate_min_clearance = c.get_double("grasp.left_plate_min_clearance_m", 0.0, 0.05);
   g.more_than_the_book = c.get_double("grasp.more_than_the_book_m", 0.0, 0.05);
   g.retry_left_clearance = c.get_double("grasp.retry_left_clearance_m", 0.0005, 0.05);  // > 0: a narrower opening
+  g.palm_half_width = c.get_double("grasp.palm_half_width_m", 0.0, 0.2);
+  g.right_panel_clearance = c.get_double("grasp.right_panel_clearance_m", 0.0, 0.05);
+  g.right_plate_min_clearance = c.get_double("grasp.right_plate_min_clearance_m", 0.0, 0.05);
   g.pre_grasp_distance = c.get_double("grasp.pre_grasp_distance_m", 0.01, 0.5);
   g.deep_front_z = c.get_double("grasp.deep_front_z_m", -0.2, 0.36);
   g.extract_lift = c.get_double("grasp.extract_lift_m", 0.0, 0.5);
@@ -168,6 +171,19 @@ PlateOpening plate_opening_after_more_than_the_book(const ForeEdges& edges, doub
   narrow.left_plate_on_neighbour = false;
   narrow.width_left_clearance = g.retry_left_clearance;
   return plate_opening(edges, open_width, narrow);
+}
+
+double palm_over_right_panel(const PlateOpening& o, double gp_y, const CycleGeometry& g) {
+  if (g.palm_half_width <= 0 || !std::isfinite(gp_y)) return 0.0;
+  return gp_y + o.offset_y + g.palm_half_width + g.right_panel_clearance - g.shelf_right_y;
+}
+
+PlateOpening plate_opening_clear_of_right_panel(const PlateOpening& o, double gp_y, const CycleGeometry& g) {
+  const double over = palm_over_right_panel(o, gp_y, g);
+  if (over <= 0) return o;
+  // The right plate's inner face (offset_y + width / 2 right of GP) stays right_plate_min_clearance right of GP.
+  const double lowest = std::min(o.offset_y, g.right_plate_min_clearance - 0.5 * o.width);
+  return {o.width, std::max(o.offset_y - over, lowest)};
 }
 
 bool holds_more_than_the_book(double plate_distance, const ForeEdges& edges, const CycleGeometry& g) {

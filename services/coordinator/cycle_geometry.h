@@ -55,6 +55,12 @@ struct CycleGeometry {
   /// open the plates only to the fore-edge + retry_left_clearance. 0 = no check.
   double more_than_the_book = 0.0;
   double retry_left_clearance = 0.005;  ///< see more_than_the_book
+  /// Not in the paper: the palm's half width across the books (Y). With it > 0, a right-most book near the right
+  /// side panel (shelf_right_y) gets the plates and the palm moved left together, so that the palm stays
+  /// right_panel_clearance left of the panel (plate_opening_clear_of_right_panel). 0 = no such shift.
+  double palm_half_width = 0.0;
+  double right_panel_clearance = 0.005;      ///< see palm_half_width
+  double right_plate_min_clearance = 0.003;  ///< the right plate's inner face at least this far right of GP
   double pre_grasp_distance = 0.10; ///< pre-grasp pose this far in front of GP along -Z
   /// Deepest GP (grasp Z) the pre-grasp and the extraction's end are measured from: a deeper front (books
   /// pushed back by an earlier grasp's left plate) gets the pre-grasp and the extraction's end a front at this
@@ -147,6 +153,16 @@ PlateOpening plate_opening_after_more_than_the_book(const ForeEdges& edges, doub
 
 /// True when plates closed to `plate_distance` hold more than the fore-edge `edges.front_width` (a measured width
 /// and more_than_the_book > 0 only).
+/// `o` moved left, plates and palm together, so that for a GP at grasp Y `gp_y` the palm's right side stays
+/// right_panel_clearance left of the right side panel (shelf_right_y). It moves no further than keeps the right
+/// plate's inner face right_plate_min_clearance right of GP (the book's right edge); the palm may then still meet
+/// the panel. `o` unchanged with palm_half_width 0, a GP far enough from the panel, or a GP not finite.
+PlateOpening plate_opening_clear_of_right_panel(const PlateOpening& o, double gp_y, const CycleGeometry& g);
+
+/// How far (m) the palm reaches past right_panel_clearance from the right side panel for a GP at grasp Y `gp_y`
+/// with the opening `o` (> 0: it meets the panel or comes too near; <= 0: clear). 0 with palm_half_width 0.
+double palm_over_right_panel(const PlateOpening& o, double gp_y, const CycleGeometry& g);
+
 bool holds_more_than_the_book(double plate_distance, const ForeEdges& edges, const CycleGeometry& g);
 /// Book height above its support at the TCP: GP.x (top above the upper shelf) plus the X offset.
 double tcp_height_on_book(const Eigen::Vector3d& gp_grasp, const CycleGeometry& g);

@@ -360,10 +360,14 @@ void LibraryCycle::start_linear(std::vector<Eigen::Isometry3d> waypoints, double
   set_deadline(length / s_.linear_max_speed + s_.motion_margin_s);
 }
 
-PlateOpening LibraryCycle::grasp_opening() const {
+PlateOpening LibraryCycle::book_opening() const {
   return narrow_after_more_than_the_book_
              ? plate_opening_after_more_than_the_book(fore_edges_, s_.gripper_open_width, s_.geometry)
              : plate_opening(fore_edges_, s_.gripper_open_width, s_.geometry);
+}
+
+PlateOpening LibraryCycle::grasp_opening() const {
+  return plate_opening_clear_of_right_panel(book_opening(), progress_.gp_grasp.y(), s_.geometry);
 }
 
 CycleGeometry LibraryCycle::grasp_geometry() const {
@@ -752,6 +756,14 @@ void LibraryCycle::enter(CycleState s) {
     case CycleState::kMoveToPreGrasp: {
       // INSERT and EXTRACT follow: the planner picks a posture from which the arm can make them.
       const CycleGeometry gw = grasp_geometry();
+      const PlateOpening opening = grasp_opening();
+      const double shift = book_opening().offset_y - opening.offset_y;
+      const double over = palm_over_right_panel(opening, progress_.gp_grasp.y(), s_.geometry);
+      if (over > 0)
+        message_ += "; the palm comes " + mm(over) + " nearer the right side panel than grasp.right_panel_clearance_m" +
+                    " allows, with the plates " + mm(shift) + " further left: INSERT may meet the panel";
+      else if (shift > 0)
+        message_ += "; plates and palm " + mm(shift) + " further left, clear of the right side panel";
       const Eigen::Isometry3d grasp = grasp_pose(gp_base_, gw);
       std::vector<Eigen::Isometry3d> then{grasp};
       for (const Eigen::Isometry3d& p : extract_moves(grasp, cart_frame(), tcp_height(),

@@ -313,7 +313,9 @@ class LibraryCycle {
   void start_linear(std::vector<Eigen::Isometry3d> waypoints, double guard = 0);
   /// Closes the plates (grasp) or opens them to `open_width` (<= 0: the full opening).
   void start_gripper(bool grasp, double open_width = 0);
-  /// This attempt's plate opening for the grasp (plate_opening() with the corner servo's fore-edges).
+  /// This attempt's plate opening for the book (plate_opening() with the corner servo's fore-edges).
+  PlateOpening book_opening() const;
+  /// book_opening() moved clear of the right side panel (plate_opening_clear_of_right_panel()).
   PlateOpening grasp_opening() const;
   /// The geometry with this attempt's grasp_opening() offset.
   CycleGeometry grasp_geometry() const;

@@ -442,6 +442,33 @@ TEST(LibraryCycle, PlatesClosedOnMoreThanTheBookTryAgainOpenedToTheBookOnly) {
   EXPECT_EQ(slice(off.states, "CLOSE_GRIPPER", 2), (std::vector<std::string>{"CLOSE_GRIPPER", "EXTRACT"}));
 }
 
+TEST(LibraryCycle, ABookNearTheRightSidePanelIsGraspedWithThePalmClearOfIt) {
+  // coordinator.yaml: the panel at cart.shelf_right_y_m 0.40, palm_half_width_m 57 mm, right_panel_clearance_m 5 mm,
+  // offset_y_m -15 mm. Book 0's right cover at 0.36: the TCP goes to 0.40 - 0.005 - 0.057 = 0.338, not 0.345.
+  const CycleSettings cs = settings();
+  ASSERT_NEAR(cs.geometry.shelf_right_y, 0.40, 1e-12);
+  ASSERT_NEAR(cs.geometry.palm_half_width, 0.057, 1e-12);
+  ASSERT_NEAR(cs.geometry.right_panel_clearance, 0.005, 1e-12);
+  ASSERT_NEAR(cs.geometry.grasp_offset_y, -0.015, 1e-12);
+  std::vector<FakeBook> books = three_books();
+  books[0].right_y = 0.36;
+  FakeLibrary w(books);
+  LibraryCycle cycle(cs, std::nullopt);
+  w.run(cycle, [&] { return done_or_aborted(cycle); });
+  ASSERT_EQ(cycle.state(), CycleState::kDone) << cycle.status().message;
+  std::vector<double> insert_end_y;  // the TCP's grasp Y at the end of each INSERT
+  for (size_t i = 0; i + 1 < w.tcp_path.size(); ++i)
+    if (w.tcp_path[i].first == "INSERT" && w.tcp_path[i + 1].first != "INSERT")
+      insert_end_y.push_back((hand_grasp_frame().inverse() * w.tcp_path[i].second).y());
+  ASSERT_EQ(insert_end_y.size(), 3u);
+  EXPECT_NEAR(insert_end_y[0], 0.338, 1e-3);
+  EXPECT_NEAR(insert_end_y[1], books[1].right_y - 0.015, 1e-3);  // far from the panel: offset_y_m as configured
+  const bool said = std::any_of(w.messages.begin(), w.messages.end(), [](const std::string& m) {
+    return m.find("plates and palm 7.0 mm further left, clear of the right side panel") != std::string::npos;
+  });
+  EXPECT_TRUE(said);
+}
+
 TEST(LibraryCycle, TheArbitersFrontDepthSetsTheCornerServosStandoff) {
   // coordinator.yaml: book_front_z_m 0.01 (when the arbiter gives no depth), bwh_start_z_m -0.08.
   const CycleSettings cs = settings();
