@@ -13,10 +13,12 @@
 #include <fstream>
 #include <iostream>
 #include <map>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <vector>
 
+#include "common/config.h"
 #include "services/eval_full/eval_report.h"
 #include "services/eval_full/full_cycle_harness.h"
 #include "services/eval_full/full_cycle_metrics.h"
@@ -234,7 +236,15 @@ int main(int argc, char** argv) {
     if (log) o.log_file = out + "/logs/seed_" + std::to_string(s) + ".lcmlog";
     o.log_channels = log_channels;
     if (snapshots) o.snapshot_dir = out + "/snapshots/seed_" + std::to_string(s);
-    SceneOutcome outcome{s, run_full_cycle(o, budget, books)};
+    std::optional<SceneOutcome> ran_scene;
+    try {
+      ran_scene = SceneOutcome{s, run_full_cycle(o, budget, books)};
+    } catch (const ConfigError& e) {
+      std::cerr << "bookgrasp_eval_full: configuration: " << e.what() << "\nNo scene of seed " << s
+                << " or later was run or recorded.\n";
+      return 2;
+    }
+    const SceneOutcome& outcome = *ran_scene;
     SceneRecord record;
     record.seed = s;
     record.options = options;

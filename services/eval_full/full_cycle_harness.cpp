@@ -46,17 +46,27 @@ struct ServiceYaml {
   std::string path;
   YAML::Node root;
   explicit ServiceYaml(const std::string& p) : path(p) {
-    if (!fs::exists(p)) throw std::runtime_error("configuration file " + p + " does not exist");
-    root = YAML::LoadFile(p);
+    if (!fs::exists(p)) throw ConfigError("configuration file " + p + " does not exist");
+    try {
+      root = YAML::LoadFile(p);
+    } catch (const YAML::Exception& e) {
+      throw ConfigError(p + ": not valid YAML: " + e.what());
+    }
   }
   /// Applies the "service:key=value" entries of `overrides` that name `service`.
   void apply(const std::string& service, const std::vector<std::string>& overrides) {
     for (const std::string& ov : overrides) {
       const auto colon = ov.find(':'), eq = ov.find('=');
       if (colon == std::string::npos || eq == std::string::npos || eq < colon)
-        throw std::runtime_error("override '" + ov + "' is not service:dotted.key=value");
+        throw ConfigError("override '" + ov + "' is not service:dotted.key=value");
       if (ov.substr(0, colon) != service) continue;
-      set(ov.substr(colon + 1, eq - colon - 1), YAML::Load(ov.substr(eq + 1)));
+      YAML::Node value;
+      try {
+        value = YAML::Load(ov.substr(eq + 1));
+      } catch (const YAML::Exception& e) {
+        throw ConfigError("override '" + ov + "': the value is not valid YAML: " + e.what());
+      }
+      set(ov.substr(colon + 1, eq - colon - 1), value);
     }
   }
   template <typename T>
@@ -67,10 +77,10 @@ struct ServiceYaml {
     std::vector<YAML::Node> chain{root};
     for (size_t i = 0; i + 1 < parts.size(); ++i) {
       YAML::Node next = chain.back()[parts[i]];
-      if (!next.IsMap()) throw std::runtime_error(path + ": no section '" + parts[i] + "' for override " + dotted);
+      if (!next.IsMap()) throw ConfigError(path + ": no section '" + parts[i] + "' for override " + dotted);
       chain.push_back(next);
     }
-    if (!chain.back()[parts.back()].IsDefined()) throw std::runtime_error(path + ": override of unknown key " + dotted);
+    if (!chain.back()[parts.back()].IsDefined()) throw ConfigError(path + ": override of unknown key " + dotted);
     chain.back()[parts.back()] = value;
   }
   std::string text() const {
@@ -811,6 +821,8 @@ FullCycleResult run_full_cycle(const FullCycleOptions& options, double budget_s,
     FullCycleResult r = h.result();
     r.end = end;
     return r;
+  } catch (const ConfigError&) {
+    throw;  // the same for every seed: not this scene's result
   } catch (const std::exception& e) {
     FullCycleResult r;
     r.end = "ERROR";

@@ -158,7 +158,8 @@ class FullCycleHarness {
 
 /// Runs one scene: builds the harness, runs until the coordinator is DONE or
 /// ABORTED, `max_books` books were moved (0 = all) or `budget_s` of simulation
-/// time. Never throws: a setup error gives end = "ERROR" with the message.
+/// time. A setup error gives end = "ERROR" with the message; a configuration error (a bad file, key, value or
+/// override, the same for every seed) throws ConfigError instead.
 FullCycleResult run_full_cycle(const FullCycleOptions& options, double budget_s, int max_books = 0);
 
 }  // namespace bookgrasp
