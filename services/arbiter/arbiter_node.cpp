@@ -72,6 +72,7 @@ ArbiterSettings ArbiterSettings::from_config(const Config& root) {
   s.tolerances.invalid_p1_depth_range = root.get_double("tolerances.invalid_p1_depth_range_m", 0.0, 0.36);
   s.tolerances.use_hand_corner = root.get<bool>("hand_corner.enabled");
   s.tolerances.hand_corner_max_y_from_p2 = root.get_double("hand_corner.max_y_from_p2_m", 0.0, 0.1);
+  s.tolerances.p2_ps_y = root.get_double("tolerances.p2_measured_ps_y_m", 0.0, 0.2);
   s.use_stereo_front = root.get<bool>("stereo_front.enabled");
   const std::vector<double> band = root.get_vector("stereo_front.probe_left_of_ps_m", 2);
   if (!(band[0] >= 0 && band[0] < band[1] && band[1] <= 0.1))
@@ -236,6 +237,7 @@ void ArbiterNode::on_servo_status(const servo_status_t& msg) {
     last_decided_request_ = msg.request_id;
     const pose_t& p = msg.converged_pose;
     ps_ = Eigen::Vector3d(p.position[0], p.position[1], p.position[2]);
+    ps_measured_ = true;
     publish_p1_check(msg.utime, msg.request_id);
     return;
   }
@@ -291,11 +293,7 @@ void ArbiterNode::publish_p1_check(int64_t utime, int64_t request_id) {
     publish(s_.channels.grasp_point, m);
     return;
   }
-  CombinationInputs in;
-  in.p1 = p1;
-  in.ps = to_grasp(*ps_);
-  in.front_z_fallback = s_.book_front_z;
-  in.stereo_front_z = stereo_front_z(in.ps);
+  const CombinationInputs in = common_inputs();
   put(m.ps_grasp, in.ps);
   const CombinationResult r = validate_p1(in, s_.tolerances);
   for (const ValidationStep& st : r.steps) m.steps.push_back(to_msg(st, utime));
@@ -329,14 +327,9 @@ void ArbiterNode::decide(const servo_status_t& msg) {
     open_attempt();
     return;
   }
-  const std::optional<Eigen::Vector3d>& p1b = frozen_ ? frozen_p1_ : latest_p1_;
-  CombinationInputs in;
-  if (p1b) in.p1 = to_grasp(*p1b);
-  in.ps = to_grasp(*ps_);
+  CombinationInputs in = common_inputs();
   const auto rank_it = rank_of_request_.find(msg.request_id);
   in.p2_rank = rank_it == rank_of_request_.end() ? 0 : rank_it->second;
-  in.front_z_fallback = s_.book_front_z;
-  in.stereo_front_z = stereo_front_z(in.ps);
   double slope = 0;
   if (converged) {
     const Eigen::Isometry3d p2 = pose_to_isometry(msg.converged_pose);
@@ -386,6 +379,11 @@ void ArbiterNode::decide(const servo_status_t& msg) {
     case GraspOutcome::kNextRegion:
       m.reason = "NEXT_REGION rank " + std::to_string(r.next_rank) + ": " + last;
       break;
+    case GraspOutcome::kP1LedAstray:
+      m.reason = "P1_LED_ASTRAY: " + last;
+      p1_astray_at_ps_ = ps_;
+      open_attempt();
+      break;
     case GraspOutcome::kNoGrasp:
       m.reason = "NO_GRASP: " + last;
       open_attempt();
@@ -394,6 +392,18 @@ void ArbiterNode::decide(const servo_status_t& msg) {
   for (const ValidationStep& st : r.steps) m.steps.push_back(to_msg(st, msg.utime));
   finish(&m, follow_, switch_note_);
   publish(s_.channels.grasp_point, m);
+}
+
+CombinationInputs ArbiterNode::common_inputs() const {
+  CombinationInputs in;
+  const std::optional<Eigen::Vector3d>& p1b = frozen_ ? frozen_p1_ : latest_p1_;
+  if (p1b) in.p1 = to_grasp(*p1b);
+  in.ps = to_grasp(*ps_);
+  in.ps_measured = ps_measured_;
+  in.p1_led_astray = p1_astray_at_ps_ && *p1_astray_at_ps_ == *ps_;
+  in.front_z_fallback = s_.book_front_z;
+  in.stereo_front_z = stereo_front_z(in.ps);
+  return in;
 }
 
 std::optional<double> ArbiterNode::stereo_front_z(const Eigen::Vector3d& ps_grasp) const {
@@ -443,6 +453,7 @@ void ArbiterNode::on_arm_state(const arm_state_t& msg) {
       // The plates opened where they closed: the grasp was given up (the coordinator backs out), so the book is still
       // on the shelf and PS goes back.
       ps_ = width_taken_->ps_before;
+      ps_measured_ = width_taken_->ps_before_measured;
       grasp_point_t m = base_message(msg.utime, width_taken_->request_id);
       if (ps_) put(m.ps_grasp, last_frame_.inverse() * *ps_);
       m.valid = false;
@@ -486,7 +497,8 @@ void ArbiterNode::on_arm_state(const arm_state_t& msg) {
   gp.translation() = last_frame_ * last_gp_grasp_;
   m.gp_base = isometry_to_pose(gp, "base", "gripper", msg.utime);
   const bool usable = bw <= s_.size_limits.l_max;
-  width_taken_ = WidthTaken{width_request_, bw, pose_to_isometry(msg.end_effector).translation(), ps_};
+  width_taken_ = WidthTaken{width_request_, bw, pose_to_isometry(msg.end_effector).translation(), ps_, ps_measured_};
+  ps_measured_ = false;
   if (usable) {
     const Eigen::Vector3d next = next_ps(last_ps_grasp_, last_gp_grasp_, bw);
     ps_ = last_frame_ * next;

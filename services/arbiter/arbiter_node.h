@@ -116,6 +116,8 @@ class ArbiterNode : public Component {
   grasp_point_t base_message(int64_t utime, int64_t request_id) const;
   Eigen::Vector3d to_grasp(const Eigen::Vector3d& p_base) const;
   Eigen::Vector3d to_base(const Eigen::Vector3d& p_grasp) const;
+  /// Fills the inputs every decision shares: P1 (frozen or latest), PS and what is known about it, the fronts.
+  CombinationInputs common_inputs() const;
   /// The attempt's stereo front depth left of `ps_grasp` (stereo_front_depth.h), if enabled and found.
   std::optional<double> stereo_front_z(const Eigen::Vector3d& ps_grasp) const;
 
@@ -130,6 +132,10 @@ class ArbiterNode : public Component {
   std::vector<plane_region_t> frozen_regions_;  ///< ... of the attempt
   bool frozen_ = false;
   std::optional<Eigen::Vector3d> ps_;          ///< base
+  bool ps_measured_ = false;                   ///< ps_ is the stripe servo's end, not GP.y - BW
+  /// The PS (base) at which a valid P1 led BwH to a left neighbour's corner (GraspOutcome::kP1LedAstray): at the
+  /// same PS, P1 is not used again.
+  std::optional<Eigen::Vector3d> p1_astray_at_ps_;
   std::map<int64_t, int> rank_of_request_;     ///< BOOK_CORNER request id -> rank
   int64_t last_decided_request_ = -1;
   // After a GRASP: book-width measurement.
@@ -146,6 +152,7 @@ class ArbiterNode : public Component {
     double bw = 0;
     Eigen::Vector3d tcp = Eigen::Vector3d::Zero();
     std::optional<Eigen::Vector3d> ps_before;
+    bool ps_before_measured = false;
   };
   std::optional<WidthTaken> width_taken_;
   std::optional<int64_t> last_arm_motion_utime_;  ///< latest ARM_STATE that showed the arm moving

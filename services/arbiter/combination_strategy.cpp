@@ -28,6 +28,8 @@ std::string outcome_name(GraspOutcome o) {
   switch (o) {
     case GraspOutcome::kGrasp: return "GRASP";
     case GraspOutcome::kNextRegion: return "NEXT_REGION";
+    case GraspOutcome::kP1LedAstray:
+      return "P1_LED_ASTRAY";
     case GraspOutcome::kNoGrasp: return "NO_GRASP";
   }
   return "?";
@@ -71,6 +73,13 @@ CombinationResult validate_p1(const CombinationInputs& in, const CombinationTole
     return r;
   }
   const double d = in.p1->y() - in.ps.y();
+  if (in.p1_led_astray) {
+    r.steps.push_back(step("P1 led BwH astray", d, tol.p1_ps_y, false,
+                           "P1 (" + mm(d) +
+                               " from PS) led BwH to a left neighbour's corner at this PS before: "
+                               "ignore BwS, BwH starts from PS"));
+    return r;
+  }
   if (std::abs(d) <= tol.p1_ps_y) {
     r.p1_valid = true;
     r.bwh_start = *in.p1;
@@ -110,6 +119,21 @@ CombinationResult combine(const CombinationInputs& in, const CombinationToleranc
           "R triangulated by the hand camera: P2.x " + mm(p2.x()) + " -> " + mm(h.x()) + " at its depth " + mm(h.z())));
       p2.x() = h.x();
     }
+  }
+
+  // Not in the paper: a measured PS is the right-most book's right edge within a few mm. A P2 far left of it, reached
+  // from a valid P1, is the corner of the book P1 lay on: a taller left neighbour of a thin right-most book.
+  if (r.p1_valid && in.ps_measured && tol.p2_ps_y > 0) {
+    const double dps = p2.y() - in.ps.y();
+    if (dps < -tol.p2_ps_y) {
+      r.steps.push_back(step("P2.y vs measured PS.y", dps, tol.p2_ps_y, false,
+                             "P2 is " + mm(-dps) +
+                                 " left of the stripe end: P1 led BwH to a left neighbour's "
+                                 "corner; the next attempt starts BwH from PS"));
+      r.outcome = GraspOutcome::kP1LedAstray;
+      return r;
+    }
+    r.steps.push_back(step("P2.y vs measured PS.y", dps, tol.p2_ps_y, true, "P2 at the stripe end's book"));
   }
 
   // The reference for P2: P1 when valid, else PS (the paper restarts BwH from PS).

@@ -37,6 +37,11 @@ struct CombinationTolerances {
   /// invalid_p1_depth_range of the model's front plane (0 there: no depth check).
   bool use_hand_corner = false;
   double hand_corner_max_y_from_p2 = 0.01;
+  /// Not in the paper: with a valid P1 and a PS the stripe servo measured (CombinationInputs::ps_measured), a P2
+  /// more than this left of PS is a left neighbour's corner that P1 led BwH to (a thin, short right-most book
+  /// beside a taller one: P1 on the taller book passed the PS check). No grasp; the next attempt ignores P1 and
+  /// starts BwH from PS (CombinationInputs::p1_led_astray). 0 = off (the paper accepts such a P2).
+  double p2_ps_y = 0.0;
 };
 
 /// One decision of the strategy, with the numbers it was made on.
@@ -50,9 +55,12 @@ struct ValidationStep {
 
 /// What the strategy concluded.
 enum class GraspOutcome {
-  kGrasp,         ///< GP is valid: grasp there
-  kNextRegion,    ///< BwH chose a false region: run it again on the next region from the right
-  kNoGrasp,       ///< no grasp point can be made (reason in the last step)
+  kGrasp,       ///< GP is valid: grasp there
+  kNextRegion,  ///< BwH chose a false region: run it again on the next region from the right
+  kNoGrasp,     ///< no grasp point can be made (reason in the last step)
+  /// P1 led BwH to a left neighbour's corner (CombinationTolerances::p2_ps_y): no grasp; the next attempt starts
+  /// BwH from PS with P1 ignored.
+  kP1LedAstray,
 };
 
 /// Inputs of one decision. P1 from BwS (may be missing), PS from BSwH or the
@@ -74,6 +82,12 @@ struct CombinationInputs {
   /// the target front's depth measured at the book (BwS's P1.z is 1.5 m away and misses pushed-back books), and
   /// its X is P2.x at that depth (the servo's converged pose assumed a depth).
   std::optional<Eigen::Vector3d> hand_corner;
+  /// PS is the stripe end measured by the stripe servo (within a few mm of the book's right edge), not the
+  /// estimate GP.y - BW after a grasp.
+  bool ps_measured = false;
+  /// At this PS, a valid P1 led BwH to a corner more than CombinationTolerances::p2_ps_y left of it before: P1 is
+  /// not used (BwH starts from PS).
+  bool p1_led_astray = false;
 };
 
 /// Result: GP (grasp frame) and every step.

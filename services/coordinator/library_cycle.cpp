@@ -1136,6 +1136,12 @@ void LibraryCycle::handle_grasp_decision(const DecisionEvent& d) {
     rank_ = d.next_rank;
     message_ = d.reason;
     succeed(CycleState::kMoveToBwhStart);
+  } else if (d.outcome == "P1_LED_ASTRAY") {
+    // Not a failed attempt: BwS's P1 took BwH to a neighbour, and the arbiter's next P1 check sends BwH from PS. It
+    // answers so once per PS, so this cannot repeat without bound. The servo is cancelled as after a failure.
+    out_.push_back(make_request(CycleRequest::Kind::kServoCancel));
+    message_ = d.reason + " (attempt " + std::to_string(attempt_) + " goes on)";
+    succeed(CycleState::kPark);
   } else {
     fail("arbiter: " + d.reason);
   }

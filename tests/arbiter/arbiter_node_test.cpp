@@ -212,13 +212,15 @@ TEST_F(ArbiterNodeTest, WholeBookP1ValidGraspWidthAndNextPs) {
   // Every rule of the strategy is in the trace, the P1 source first.
   std::vector<std::string> rules;
   for (const auto& s : gp.steps) rules.push_back(s.rule);
-  ASSERT_GE(rules.size(), 5u);
+  ASSERT_GE(rules.size(), 6u);
   EXPECT_EQ(rules[0], "P1 source");
   EXPECT_EQ(rules[1], "P1.y vs PS.y");
-  EXPECT_EQ(rules[2], "P2.y vs P1.y");
-  EXPECT_EQ(rules[3], "P2.x vs P1.x");
-  EXPECT_EQ(rules[4], "GP.z");
-  EXPECT_NEAR(gp.steps[2].value_m, 0.01, kTol);
+  EXPECT_EQ(rules[2], "P2.y vs measured PS.y");  // PS from the stripe servo: P2 5 mm right of it
+  EXPECT_EQ(rules[3], "P2.y vs P1.y");
+  EXPECT_EQ(rules[4], "P2.x vs P1.x");
+  EXPECT_EQ(rules[5], "GP.z");
+  EXPECT_NEAR(gp.steps[2].value_m, 0.005, kTol);
+  EXPECT_NEAR(gp.steps[3].value_m, 0.01, kTol);
 
   // A repeated CONVERGED status of the same request is not decided twice.
   send("SERVO_STATUS", status(6100, 2, servo_request_t::BOOK_CORNER, servo_status_t::CONVERGED, {0.45, -0.31, 0.26}));
@@ -335,14 +337,48 @@ TEST_F(ArbiterNodeTest, FalseRegionAsksForNextRankThenGrasps) {
   // A new BwS frame during the servo (arm in view) must not replace the frozen P1 or answer a check.
   send("BOOK_CORNER_STEREO", corner(6500, "god", true, {0.61, -0.10, 0.40}));
   EXPECT_EQ(out.got.size(), 3u);
-  // Rank 1 converges 20 mm LEFT of P1 and 30 mm BELOW it: P2.y accepted (P1 right of P2), P2.x = P1.x.
-  // P2 grasp (0.22, 0.23, -0.15) -> GP = (0.25, 0.23, 0.01).
+  // Rank 1 converges 3 mm LEFT of P1 (8 mm left of the measured PS, within tolerances.p2_measured_ps_y_m) and 30 mm
+  // BELOW it: P2.y accepted, P2.x = P1.x. P2 grasp (0.22, 0.247, -0.15) -> GP = (0.25, 0.247, 0.01).
   send("SERVO_REQUEST", request(7000, 3, servo_request_t::BOOK_CORNER, 1));
-  send("SERVO_STATUS", status(8000, 3, servo_request_t::BOOK_CORNER, servo_status_t::CONVERGED, {0.45, -0.28, 0.22}));
+  send("SERVO_STATUS", status(8000, 3, servo_request_t::BOOK_CORNER, servo_status_t::CONVERGED, {0.45, -0.297, 0.22}));
   ASSERT_EQ(out.got.size(), 4u);
   EXPECT_TRUE(starts_with(out.got[3].reason, "GRASP")) << out.got[3].reason;
-  expect_vec(out.got[3].gp_grasp, {0.25, 0.23, 0.01}, "gp after rank 1");
+  expect_vec(out.got[3].gp_grasp, {0.25, 0.247, 0.01}, "gp after rank 1");
   expect_vec(out.got[3].p1_grasp, {0.25, 0.25, 0.01}, "frozen P1");
+}
+
+// A thin right-most book beside a taller one: P1 on the taller book passes the PS check, BwH goes to that book's
+// corner 15 mm left of the measured PS. No grasp; the next P1 check at the same PS ignores P1 (BwH from PS), and a
+// PS measured anew is trusted with P1 again.
+TEST_F(ArbiterNodeTest, AP1ThatLedBwhToTheNeighbourIsNotUsedAgainAtThatPs) {
+  // P1 base y -0.298 -> grasp 0.248, 7 mm left of PS.y 0.255: valid.
+  first_run({0.61, -0.298, 0.25}, {0.45, -0.305, 0.10});
+  ASSERT_EQ(out.got.size(), 2u);
+  EXPECT_TRUE(starts_with(out.got[1].reason, "P1_VALID")) << out.got[1].reason;
+  // P2 grasp y 0.240 (base -0.29): 15 mm left of PS, 8 mm left of P1.
+  send("SERVO_REQUEST", request(5000, 2, servo_request_t::BOOK_CORNER, 0));
+  send("SERVO_STATUS", status(6000, 2, servo_request_t::BOOK_CORNER, servo_status_t::CONVERGED, {0.45, -0.29, 0.26}));
+  ASSERT_EQ(out.got.size(), 3u);
+  EXPECT_TRUE(starts_with(out.got[2].reason, "P1_LED_ASTRAY: P2 is 15.0 mm left of the stripe end"))
+      << out.got[2].reason;
+  EXPECT_FALSE(out.got[2].valid);
+  // The coordinator's next attempt asks for the P1 check again (a new BwS frame).
+  send("BOOK_CORNER_STEREO", corner(7000, "god", true, {0.61, -0.298, 0.25}));
+  ASSERT_EQ(out.got.size(), 4u);
+  EXPECT_TRUE(starts_with(out.got[3].reason, "P1_INVALID: P1 (-7.0 mm from PS) led BwH")) << out.got[3].reason;
+  EXPECT_FALSE(out.got[3].p1_used);
+  expect_vec(out.got[3].gp_grasp, {0.10, 0.255, 0.01}, "BwH start = PS, front depth");
+  // From PS, BwH converges at the thin book's corner (grasp (0.20, 0.253)): grasped, P1 not used.
+  send("SERVO_REQUEST", request(8000, 3, servo_request_t::BOOK_CORNER, 0));
+  send("SERVO_STATUS", status(9000, 3, servo_request_t::BOOK_CORNER, servo_status_t::CONVERGED, {0.45, -0.303, 0.20}));
+  ASSERT_EQ(out.got.size(), 5u);
+  EXPECT_TRUE(starts_with(out.got[4].reason, "GRASP")) << out.got[4].reason;
+  EXPECT_FALSE(out.got[4].p1_used);
+  // A new stripe measurement (another PS): P1 is checked as usual again.
+  send("SERVO_REQUEST", request(10000, 4, servo_request_t::STRIPE_END));
+  send("SERVO_STATUS", status(11000, 4, servo_request_t::STRIPE_END, servo_status_t::CONVERGED, {0.45, -0.302, 0.10}));
+  ASSERT_EQ(out.got.size(), 6u);
+  EXPECT_TRUE(starts_with(out.got[5].reason, "P1_VALID")) << out.got[5].reason;
 }
 
 TEST_F(ArbiterNodeTest, NoRegionLeftGivesNoGrasp) {

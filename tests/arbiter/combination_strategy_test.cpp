@@ -286,6 +286,53 @@ TEST(CombinationStrategy, P1ValidityBoundaryAndTrace) {
   EXPECT_DOUBLE_EQ(r.steps[0].tolerance, 0.01);
 }
 
+TEST(CombinationStrategy, AP2FarLeftOfAMeasuredPsIsTheNeighbourP1LedBwhTo) {
+  // A 12 mm right-most book, short, beside a taller one: the stripe servo measured PS at its right edge (Y 0.100);
+  // BwS's P1 lay on the taller book 7 mm left (valid: within 10 mm of PS); BwH went from P1 to the taller book's
+  // corner, 15 mm left of PS and 8 mm left of P1 (the paper accepts it in Y, within 1.5 cm of P1).
+  CombinationTolerances tol = kTol;
+  tol.p2_ps_y = 0.010;
+  CombinationInputs in;
+  in.ps = kPs;
+  in.ps_measured = true;
+  in.p1 = V(0.20, 0.093, 0.40);
+  in.p2 = V(0.21, 0.085, 0.45);
+  const CombinationResult r = combine(in, tol);
+  EXPECT_EQ(r.outcome, GraspOutcome::kP1LedAstray);
+  ASSERT_FALSE(r.steps.empty());
+  EXPECT_EQ(r.steps.back().rule, "P2.y vs measured PS.y");
+  EXPECT_NEAR(r.steps.back().value, -0.015, 1e-12);
+  EXPECT_NE(r.steps.back().decision.find("the next attempt starts BwH from PS"), std::string::npos);
+  EXPECT_EQ(outcome_name(r.outcome), "P1_LED_ASTRAY");
+  // 9 mm left of PS: the book at the stripe end, grasped (GP = P2.x, P2.y, P1.z).
+  in.p2 = V(0.21, 0.091, 0.45);
+  EXPECT_EQ(combine(in, tol).outcome, GraspOutcome::kGrasp);
+  EXPECT_TRUE(combine(in, tol).gp.isApprox(V(0.21, 0.091, 0.40), 1e-12));
+  in.p2 = V(0.21, 0.085, 0.45);
+  // A PS estimated from the last grasp (GP.y - BW), or the rule off: the paper's rules accept the P2.
+  for (const bool measured : {false, true}) {
+    CombinationInputs e = in;
+    e.ps_measured = measured;
+    CombinationTolerances t = tol;
+    if (measured) t.p2_ps_y = 0.0;
+    const CombinationResult g = combine(e, t);
+    EXPECT_EQ(g.outcome, GraspOutcome::kGrasp) << measured;
+    EXPECT_TRUE(g.gp.isApprox(V(0.21, 0.085, 0.40), 1e-12)) << measured;
+  }
+  // Without a valid P1 (BwH started from PS already) nothing led BwH astray: the paper's rule (P2 left of PS).
+  CombinationInputs no_p1 = in;
+  no_p1.p1.reset();
+  no_p1.front_z_fallback = 0.42;
+  EXPECT_EQ(combine(no_p1, tol).outcome, GraspOutcome::kGrasp);
+  // The next attempt at the same PS: P1 is not used, BwH starts from PS.
+  in.p1_led_astray = true;
+  const CombinationResult check = validate_p1(in, tol);
+  EXPECT_FALSE(check.p1_valid);
+  EXPECT_TRUE(check.bwh_start.head<2>().isApprox(kPs.head<2>(), 1e-12));
+  ASSERT_FALSE(check.steps.empty());
+  EXPECT_EQ(check.steps.back().rule, "P1 led BwH astray");
+}
+
 TEST(CombinationStrategy, NextPsAfterAGrasp) {
   // GP.y = 0.105, a 2.3 cm book: the next book's right edge is expected at 0.082.
   const V ps = next_ps(kPs, V(0.1, 0.105, 0.4), 0.023);

@@ -115,11 +115,13 @@ namespace {
 // on seed 5 (bookgrasp_eval_full --scenes 1 --seed 5 --scene config/scenes/default.yaml --books 3 --stereo-hz 2
 // --log --log-channels BOOK_CORNER_STEREO,SERVO_STATUS,SERVO_REQUEST,MARKERS,ARM_STATE,DETECTOR_SWITCH,GRASP_POINT
 // --out DIR, then DIR/logs/seed_5.lcmlog: three books through the whole cycle (stop 27); at first two, the third
-// ABORTED when the corner servo stopped at a joint limit); re-recorded 2026-12-04 (stop 27) when the cart tag moved
-// 0.10 m right (scene markers.cart.y_m 0.20); re-recorded 2026-12-04 (stop 26) when the arbiter began to read the book
-// width only while the arm executes no motion (three books through the whole cycle); re-recorded 2026-12-03 (stop 20)
-// when SERVO_STATUS gained the triangulated corner; before (stop 19) when the P1 check's gp_grasp Z became the corner
-// servo's front depth and the stereo front left of PS (arbiter.yaml stereo_front) joined GP.z's rules.
+// ABORTED when the corner servo stopped at a joint limit); re-recorded 2026-12-05 (stop 28) when the arbiter began
+// to check P2 against a PS the stripe servo measured (tolerances.p2_measured_ps_y_m, one more step in GRASP);
+// re-recorded 2026-12-04 (stop 27) when the cart tag moved 0.10 m right (scene markers.cart.y_m 0.20); re-recorded
+// 2026-12-04 (stop 26) when the arbiter began to read the book width only while the arm executes no motion (three books
+// through the whole cycle); re-recorded 2026-12-03 (stop 20) when SERVO_STATUS gained the triangulated corner; before
+// (stop 19) when the P1 check's gp_grasp Z became the corner servo's front depth and the stereo front left of PS
+// (arbiter.yaml stereo_front) joined GP.z's rules.
 DiffReport replay_arbiter(const std::string& config_path) {
   const auto log = read_lcm_log(std::string(BOOKGRASP_SOURCE_DIR) + "/logs/samples/arbiter_seed5.lcm");
   std::vector<std::unique_ptr<Component>> cs;
