@@ -371,6 +371,10 @@ void ArbiterNode::decide(const servo_status_t& msg) {
       width_request_ = msg.request_id;
       last_gp_grasp_ = r.gp;
       last_ps_grasp_ = in.ps;
+      corner_at_ps_.reset();
+      for (const ValidationStep& st : r.steps)
+        if (st.rule == "hand corner" && st.passed && in.hand_corner)
+          corner_at_ps_ = CornerAtPs{*ps_, in.hand_corner->z()};
       last_frame_ = *frame_;
       settle_start_utime_ = -1;
       open_attempt();
@@ -401,6 +405,7 @@ CombinationInputs ArbiterNode::common_inputs() const {
   in.ps = to_grasp(*ps_);
   in.ps_measured = ps_measured_;
   in.p1_led_astray = p1_astray_at_ps_ && *p1_astray_at_ps_ == *ps_;
+  if (corner_at_ps_ && corner_at_ps_->ps == *ps_) in.earlier_corner_z = corner_at_ps_->z;
   in.front_z_fallback = s_.book_front_z;
   in.stereo_front_z = stereo_front_z(in.ps);
   return in;

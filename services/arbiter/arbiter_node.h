@@ -136,6 +136,13 @@ class ArbiterNode : public Component {
   /// The PS (base) at which a valid P1 led BwH to a left neighbour's corner (GraspOutcome::kP1LedAstray): at the
   /// same PS, P1 is not used again.
   std::optional<Eigen::Vector3d> p1_astray_at_ps_;
+  /// R's depth (grasp Z) the corner servo triangulated for the last GRASP, and the PS (base) it was decided at:
+  /// CombinationInputs::earlier_corner_z while PS stays that one (a failed attempt at the same book).
+  struct CornerAtPs {
+    Eigen::Vector3d ps;
+    double z = 0.0;
+  };
+  std::optional<CornerAtPs> corner_at_ps_;
   std::map<int64_t, int> rank_of_request_;     ///< BOOK_CORNER request id -> rank
   int64_t last_decided_request_ = -1;
   // After a GRASP: book-width measurement.

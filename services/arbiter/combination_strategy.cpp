@@ -46,6 +46,11 @@ std::optional<double> front_depth_without_p1(const CombinationInputs& in, const 
                 "no valid P1: GP.z from the stereo plane just left of PS (the target's front, pushed back or not)");
     return *in.stereo_front_z;
   }
+  if (in.earlier_corner_z && near_model(*in.earlier_corner_z)) {
+    *out = step("GP.z", *in.earlier_corner_z - *in.front_z_fallback, tol.invalid_p1_depth_range, true,
+                "no valid P1: GP.z from R's depth the corner servo triangulated at this PS in an earlier attempt");
+    return *in.earlier_corner_z;
+  }
   if (in.p1 && in.p1->allFinite() && near_model(in.p1->z())) {
     *out = step("GP.z", in.p1->z() - *in.front_z_fallback, tol.invalid_p1_depth_range, true,
                 "P1 invalid in Y: GP.z = P1.z (its front stands as deep as the target's, not the cart model's plane)");

@@ -82,6 +82,11 @@ struct CombinationInputs {
   /// the target front's depth measured at the book (BwS's P1.z is 1.5 m away and misses pushed-back books), and
   /// its X is P2.x at that depth (the servo's converged pose assumed a depth).
   std::optional<Eigen::Vector3d> hand_corner;
+  /// Not in the paper: R's depth (grasp Z) the corner servo triangulated in an earlier attempt at this same PS (the
+  /// book not taken since). Without a valid P1 it gives the depth after the stereo front and before an invalid P1's
+  /// or the model's, within invalid_p1_depth_range of the model: a book pushed deep by a failed insertion, which BwS
+  /// no longer sees, is servoed at its own depth, not at the model's front plane.
+  std::optional<double> earlier_corner_z;
   /// PS is the stripe end measured by the stripe servo (within a few mm of the book's right edge), not the
   /// estimate GP.y - BW after a grasp.
   bool ps_measured = false;

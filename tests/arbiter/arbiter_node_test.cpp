@@ -478,6 +478,34 @@ TEST_F(ArbiterNodeTest, TheServosTriangulatedCornerGivesGpZAndX) {
   EXPECT_TRUE(said);
 }
 
+// An attempt whose GRASP came with R triangulated 12 cm deep, then failed before the plates closed (an insertion that
+// timed out): PS stays, and the next P1 check without a valid P1 starts the corner servo at R's depth, not at the
+// model's plane (whole-shelf far_cart seed 1, book 7). A new PS forgets it.
+TEST_F(ArbiterNodeTest, ACornerTriangulatedAtThisPsGivesTheNextAttemptsDepth) {
+  first_run({0.61, -0.30, 0.25}, {0.45, -0.305, 0.10});
+  send("SERVO_REQUEST", request(5000, 2, servo_request_t::BOOK_CORNER, 0));
+  servo_status_t st = status(6000, 2, servo_request_t::BOOK_CORNER, servo_status_t::CONVERGED, {0.45, -0.31, 0.24});
+  st.corner_triangulated = true;
+  st.corner_base[0] = 0.73;  // grasp (0.235, 0.262, 0.13): 12 cm behind the model's plane (0.01)
+  st.corner_base[1] = -0.312;
+  st.corner_base[2] = 0.235;
+  send("SERVO_STATUS", st);
+  ASSERT_EQ(out.got.size(), 3u);
+  ASSERT_TRUE(starts_with(out.got[2].reason, "GRASP")) << out.got[2].reason;
+  ASSERT_NEAR(out.got[2].gp_grasp[2], 0.13, kTol);
+  // The next attempt: BwS sees no book near PS (P1 3 cm right of it: invalid, at the model's depth).
+  send("BOOK_CORNER_STEREO", corner(7000, "god", true, {0.61, -0.335, 0.25}));
+  ASSERT_EQ(out.got.size(), 4u);
+  EXPECT_TRUE(starts_with(out.got[3].reason, "P1_INVALID")) << out.got[3].reason;
+  EXPECT_NEAR(out.got[3].gp_grasp[2], 0.13, kTol) << "the corner servo's depth: R's, not the model's 0.01";
+  // A new stripe measurement (another PS): the model's depth again.
+  send("SERVO_REQUEST", request(8000, 3, servo_request_t::STRIPE_END));
+  send("SERVO_STATUS", status(9000, 3, servo_request_t::STRIPE_END, servo_status_t::CONVERGED, {0.45, -0.303, 0.10}));
+  ASSERT_EQ(out.got.size(), 5u);
+  EXPECT_TRUE(starts_with(out.got[4].reason, "P1_INVALID")) << out.got[4].reason;
+  EXPECT_NEAR(out.got[4].gp_grasp[2], 0.01, kTol);
+}
+
 TEST_F(ArbiterNodeTest, ServoFailureIsNoGraspAndOpensANewAttempt) {
   first_run({0.61, -0.30, 0.25}, {0.45, -0.305, 0.10});
   send("SERVO_REQUEST", request(5000, 2, servo_request_t::BOOK_CORNER, 0));

@@ -228,6 +228,30 @@ TEST(CombinationStrategy, TheStereoFrontLeftOfPsComesBeforeAnInvalidP1sDepth) {
   EXPECT_EQ(outcome_name(combine(in, tol).outcome), outcome_name(GraspOutcome::kNoGrasp));
 }
 
+TEST(CombinationStrategy, AnEarlierAttemptsCornerDepthComesAfterTheStereoFrontAndBeforeAnInvalidP1s) {
+  // The whole-shelf far_cart seed 1 book 7: pushed 13 cm deep by a failed insertion; no P1 near PS, no stereo front.
+  CombinationTolerances tol;
+  CombinationInputs in = depth_case(&tol);  // model plane 0.42, range 0.15
+  in.p1 = V(0.10, 0.060, 0.43);             // an invalid P1 on a neighbour, at the model's depth
+  in.earlier_corner_z = 0.55;               // R triangulated 13 cm behind the model's plane at the last attempt
+  CombinationResult r = combine(in, tol);
+  ASSERT_EQ(r.outcome, GraspOutcome::kGrasp);
+  EXPECT_DOUBLE_EQ(r.gp.z(), 0.55);
+  EXPECT_NE(r.steps.back().decision.find("earlier attempt"), std::string::npos) << r.steps.back().decision;
+  EXPECT_DOUBLE_EQ(validate_p1(in, tol).bwh_start.z(), 0.55);  // the corner servo's standoff follows
+  // A stereo front left of PS is a measurement of now: it comes first.
+  in.stereo_front_z = 0.50;
+  EXPECT_DOUBLE_EQ(validate_p1(in, tol).bwh_start.z(), 0.50);
+  in.stereo_front_z.reset();
+  // Beyond the range of the model's plane (0.42 + 0.15): not used; the invalid P1's depth is next.
+  in.earlier_corner_z = 0.58;
+  EXPECT_DOUBLE_EQ(validate_p1(in, tol).bwh_start.z(), 0.43);
+  // A valid P1 gives the depth as in the paper, whatever was triangulated before.
+  in.earlier_corner_z = 0.55;
+  in.p1 = V(0.10, 0.103, 0.43);
+  EXPECT_DOUBLE_EQ(validate_p1(in, tol).bwh_start.z(), 0.43);
+}
+
 TEST(CombinationStrategy, TheHandCornerGivesGpZAndP2XBeforeEveryOtherDepth) {
   CombinationTolerances tol;
   CombinationInputs in = depth_case(&tol);
