@@ -142,6 +142,11 @@ class ArbiterNodeTest : public testing::Test {
     send("SERVO_REQUEST", request(3000, 1, servo_request_t::STRIPE_END));
     send("SERVO_STATUS", status(4000, 1, servo_request_t::STRIPE_END, servo_status_t::CONVERGED, ps_base));
   }
+  /// A BOOK_CORNER servo request `id` of BwH rank `rank` at `t`, converged 1 ms later with the TCP at `tcp_base`.
+  void corner_converged(int64_t t, int64_t id, int rank, const Eigen::Vector3d& tcp_base) {
+    send("SERVO_REQUEST", request(t, id, servo_request_t::BOOK_CORNER, rank));
+    send("SERVO_STATUS", status(t + 1000, id, servo_request_t::BOOK_CORNER, servo_status_t::CONVERGED, tcp_base));
+  }
   /// The first run, then BwH rank 0 converging where P1 is: the GRASP decision, the third message. PS grasp (0.10,
   /// 0.255, -0.15).
   void grasp_decided() {
@@ -192,8 +197,7 @@ TEST_F(ArbiterNodeTest, WholeBookP1ValidGraspWidthAndNextPs) {
 
   // BwH rank 0 converges at base (0.45, -0.31, 0.26) -> grasp (0.26, 0.26, -0.15): dy = +10 mm < 15,
   // dx = +10 mm < 20 -> GP = (P2.x, P2.y, P1.z) = (0.26, 0.26, 0.01) -> base (0.61, -0.31, 0.26).
-  send("SERVO_REQUEST", request(5000, 2, servo_request_t::BOOK_CORNER, 0));
-  send("SERVO_STATUS", status(6000, 2, servo_request_t::BOOK_CORNER, servo_status_t::CONVERGED, {0.45, -0.31, 0.26}));
+  corner_converged(5000, 2, 0, {0.45, -0.31, 0.26});
   ASSERT_EQ(out.got.size(), 3u);
   const grasp_point_t& gp = out.got[2];
   EXPECT_TRUE(starts_with(gp.reason, "GRASP")) << gp.reason;
@@ -329,8 +333,7 @@ TEST_F(ArbiterNodeTest, PlatesOpenedAwayFromTheShelfKeepTheWidthsPs) {
 TEST_F(ArbiterNodeTest, FalseRegionAsksForNextRankThenGrasps) {
   first_run({0.61, -0.30, 0.25}, {0.45, -0.305, 0.10});
   // Rank 0 converges 30 mm right of P1 (grasp y 0.28, base y -0.33): false region -> NEXT_REGION rank 1.
-  send("SERVO_REQUEST", request(5000, 2, servo_request_t::BOOK_CORNER, 0));
-  send("SERVO_STATUS", status(6000, 2, servo_request_t::BOOK_CORNER, servo_status_t::CONVERGED, {0.45, -0.33, 0.25}));
+  corner_converged(5000, 2, 0, {0.45, -0.33, 0.25});
   ASSERT_EQ(out.got.size(), 3u);
   EXPECT_TRUE(starts_with(out.got[2].reason, "NEXT_REGION rank 1")) << out.got[2].reason;
   EXPECT_FALSE(out.got[2].valid);
@@ -339,8 +342,7 @@ TEST_F(ArbiterNodeTest, FalseRegionAsksForNextRankThenGrasps) {
   EXPECT_EQ(out.got.size(), 3u);
   // Rank 1 converges 3 mm LEFT of P1 (8 mm left of the measured PS, within tolerances.p2_measured_ps_y_m) and 30 mm
   // BELOW it: P2.y accepted, P2.x = P1.x. P2 grasp (0.22, 0.247, -0.15) -> GP = (0.25, 0.247, 0.01).
-  send("SERVO_REQUEST", request(7000, 3, servo_request_t::BOOK_CORNER, 1));
-  send("SERVO_STATUS", status(8000, 3, servo_request_t::BOOK_CORNER, servo_status_t::CONVERGED, {0.45, -0.297, 0.22}));
+  corner_converged(7000, 3, 1, {0.45, -0.297, 0.22});
   ASSERT_EQ(out.got.size(), 4u);
   EXPECT_TRUE(starts_with(out.got[3].reason, "GRASP")) << out.got[3].reason;
   expect_vec(out.got[3].gp_grasp, {0.25, 0.247, 0.01}, "gp after rank 1");
@@ -356,8 +358,7 @@ TEST_F(ArbiterNodeTest, AP1ThatLedBwhToTheNeighbourIsNotUsedAgainAtThatPs) {
   ASSERT_EQ(out.got.size(), 2u);
   EXPECT_TRUE(starts_with(out.got[1].reason, "P1_VALID")) << out.got[1].reason;
   // P2 grasp y 0.240 (base -0.29): 15 mm left of PS, 8 mm left of P1.
-  send("SERVO_REQUEST", request(5000, 2, servo_request_t::BOOK_CORNER, 0));
-  send("SERVO_STATUS", status(6000, 2, servo_request_t::BOOK_CORNER, servo_status_t::CONVERGED, {0.45, -0.29, 0.26}));
+  corner_converged(5000, 2, 0, {0.45, -0.29, 0.26});
   ASSERT_EQ(out.got.size(), 3u);
   EXPECT_TRUE(starts_with(out.got[2].reason, "P1_LED_ASTRAY: P2 is 15.0 mm left of the stripe end"))
       << out.got[2].reason;
@@ -369,8 +370,7 @@ TEST_F(ArbiterNodeTest, AP1ThatLedBwhToTheNeighbourIsNotUsedAgainAtThatPs) {
   EXPECT_FALSE(out.got[3].p1_used);
   expect_vec(out.got[3].gp_grasp, {0.10, 0.255, 0.01}, "BwH start = PS, front depth");
   // From PS, BwH converges at the thin book's corner (grasp (0.20, 0.253)): grasped, P1 not used.
-  send("SERVO_REQUEST", request(8000, 3, servo_request_t::BOOK_CORNER, 0));
-  send("SERVO_STATUS", status(9000, 3, servo_request_t::BOOK_CORNER, servo_status_t::CONVERGED, {0.45, -0.303, 0.20}));
+  corner_converged(8000, 3, 0, {0.45, -0.303, 0.20});
   ASSERT_EQ(out.got.size(), 5u);
   EXPECT_TRUE(starts_with(out.got[4].reason, "GRASP")) << out.got[4].reason;
   EXPECT_FALSE(out.got[4].p1_used);
@@ -383,8 +383,7 @@ TEST_F(ArbiterNodeTest, AP1ThatLedBwhToTheNeighbourIsNotUsedAgainAtThatPs) {
 
 TEST_F(ArbiterNodeTest, NoRegionLeftGivesNoGrasp) {
   first_run({0.61, -0.30, 0.25}, {0.45, -0.305, 0.10});
-  send("SERVO_REQUEST", request(5000, 2, servo_request_t::BOOK_CORNER, 2));
-  send("SERVO_STATUS", status(6000, 2, servo_request_t::BOOK_CORNER, servo_status_t::CONVERGED, {0.45, -0.33, 0.25}));
+  corner_converged(5000, 2, 2, {0.45, -0.33, 0.25});
   ASSERT_EQ(out.got.size(), 3u);
   EXPECT_TRUE(starts_with(out.got[2].reason, "NO_GRASP")) << out.got[2].reason;
   EXPECT_NE(out.got[2].reason.find("max_rank 3"), std::string::npos) << out.got[2].reason;
@@ -400,8 +399,7 @@ TEST_F(ArbiterNodeTest, InvalidP1StartsBwhFromPsAndTakesZFromCartModel) {
   // is invalid in Y but its Z lies within invalid_p1_depth_range_m of book_front_z_m 0.01 -> 0.01.
   expect_vec(out.got[1].gp_grasp, {0.10, 0.255, 0.01}, "BwH start = PS, front depth");
   // P2 grasp (0.24, 0.26, -0.15): 5 mm right of PS -> valid; no P1 -> X as is, Z = book_front_z_m 0.01.
-  send("SERVO_REQUEST", request(5000, 2, servo_request_t::BOOK_CORNER, 0));
-  send("SERVO_STATUS", status(6000, 2, servo_request_t::BOOK_CORNER, servo_status_t::CONVERGED, {0.45, -0.31, 0.24}));
+  corner_converged(5000, 2, 0, {0.45, -0.31, 0.24});
   ASSERT_EQ(out.got.size(), 3u);
   EXPECT_TRUE(starts_with(out.got[2].reason, "GRASP")) << out.got[2].reason;
   EXPECT_FALSE(out.got[2].p1_used);
