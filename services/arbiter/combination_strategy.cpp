@@ -126,21 +126,6 @@ CombinationResult combine(const CombinationInputs& in, const CombinationToleranc
     }
   }
 
-  // Not in the paper: a measured PS is the right-most book's right edge within a few mm. A P2 far left of it, reached
-  // from a valid P1, is the corner of the book P1 lay on: a taller left neighbour of a thin right-most book.
-  if (r.p1_valid && in.ps_measured && tol.p2_ps_y > 0) {
-    const double dps = p2.y() - in.ps.y();
-    if (dps < -tol.p2_ps_y) {
-      r.steps.push_back(step("P2.y vs measured PS.y", dps, tol.p2_ps_y, false,
-                             "P2 is " + mm(-dps) +
-                                 " left of the stripe end: P1 led BwH to a left neighbour's "
-                                 "corner; the next attempt starts BwH from PS"));
-      r.outcome = GraspOutcome::kP1LedAstray;
-      return r;
-    }
-    r.steps.push_back(step("P2.y vs measured PS.y", dps, tol.p2_ps_y, true, "P2 at the stripe end's book"));
-  }
-
   // The reference for P2: P1 when valid, else PS (the paper restarts BwH from PS).
   const Eigen::Vector3d ref = r.p1_valid ? *in.p1 : in.ps;
   const std::string ref_name = r.p1_valid ? "P1" : "PS";
@@ -163,6 +148,22 @@ CombinationResult combine(const CombinationInputs& in, const CombinationToleranc
       return r;
     }
   }
+  // Not in the paper: a measured PS is the right-most book's right edge within a few mm. A P2 far left of it, reached
+  // from a valid P1, is the corner of the book P1 lay on: a taller left neighbour of a thin right-most book. (After the
+  // rule above: a P2 left of and above a P1 on the right book keeps GP = P1.)
+  if (r.p1_valid && in.ps_measured && tol.p2_ps_y > 0) {
+    const double dps = p2.y() - in.ps.y();
+    if (dps < -tol.p2_ps_y) {
+      r.steps.push_back(step("P2.y vs measured PS.y", dps, tol.p2_ps_y, false,
+                             "P2 is " + mm(-dps) +
+                                 " left of the stripe end: P1 led BwH to a left neighbour's "
+                                 "corner; the next attempt starts BwH from PS"));
+      r.outcome = GraspOutcome::kP1LedAstray;
+      return r;
+    }
+    r.steps.push_back(step("P2.y vs measured PS.y", dps, tol.p2_ps_y, true, "P2 at the stripe end's book"));
+  }
+
   if (std::abs(dy) < tol.y) {
     r.steps.push_back(step("P2.y vs " + ref_name + ".y", dy, tol.y, true, "P2.y valid: within the Y tolerance"));
   } else if (dy < 0) {

@@ -343,6 +343,14 @@ TEST(CombinationStrategy, AP2FarLeftOfAMeasuredPsIsTheNeighbourP1LedBwhTo) {
     EXPECT_EQ(g.outcome, GraspOutcome::kGrasp) << measured;
     EXPECT_TRUE(g.gp.isApprox(V(0.21, 0.085, 0.40), 1e-12)) << measured;
   }
+  // P2 left of AND above a P1 at the stripe end: a taller neighbour's corner beside the right book, GP = P1 (the
+  // left-neighbour rule comes first; nothing to re-route).
+  CombinationInputs taller = in;
+  taller.p1 = V(0.20, 0.099, 0.40);
+  taller.p2 = V(0.25, 0.080, 0.45);
+  const CombinationResult keep = combine(taller, tol);
+  EXPECT_EQ(keep.outcome, GraspOutcome::kGrasp);
+  EXPECT_TRUE(keep.gp.isApprox(V(0.20, 0.099, 0.40), 1e-12)) << keep.gp.transpose();
   // Without a valid P1 (BwH started from PS already) nothing led BwH astray: the paper's rule (P2 left of PS).
   CombinationInputs no_p1 = in;
   no_p1.p1.reset();
