@@ -146,6 +146,12 @@ void write_report(const std::string& dir, const EvalMetrics& m, const std::strin
        << "XYZ"[k] << " mean / min / max (n) | " << f2(e.mean, "%.1f") << " / " << f2(e.min, "%.1f") << " / "
        << f2(e.max, "%.1f") << " mm (" << e.n << ") | - |\n";
   }
+  for (int k = 0; k < 4; ++k) {
+    const Stats e = stats_of(m.plates_over_fore_edge_mm[k]);
+    md << "| plates - fore-edge at the close, " << kCloseOutcomes[k] << " min / median / max (n) | "
+       << f2(e.min, "%.1f") << " / " << f2(e.median, "%.1f") << " / " << f2(e.max, "%.1f") << " mm (" << e.n
+       << ") | - |\n";
+  }
   md << "| cycle time per book median / p95 | " << f2(c.median, "%.0f") << " / " << f2(c.p95, "%.0f") << " s | - |\n";
   md << "| planning time mean / max | " << f2(p.mean, "%.0f") << " / " << f2(p.max, "%.0f") << " ms | < 2 s |\n\n";
   md << "![rates](rates.png)\n![width error](width_error.png)\n![P1-P2](p1_p2_y.png)\n"

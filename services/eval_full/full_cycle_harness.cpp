@@ -151,6 +151,7 @@ struct FullCycleHarness::Impl {
   std::string marker_roles = "-";
   std::string ch_servo = "SERVO_STATUS", ch_stripe = "STRIPE_FEATURES_HAND", ch_book = "BOOK_FEATURES_HAND";
   std::string last_gp_reason, last_servo_line, last_stripe_line, last_book_line;
+  double last_front_width = 0;  ///< the last converged corner servo's fore-edge width (0 = none)
   int64_t last_servo_trace = 0;
   stripe_features_t last_stripe_f{};
   book_features_hand_t last_book_f{};
@@ -399,6 +400,7 @@ struct FullCycleHarness::Impl {
       last_servo_trace = m->utime;
     }
     last_servo_line = line;
+    if (m->mode == 1 && m->state == servo_status_t::CONVERGED) last_front_width = m->front_width_m;  // BOOK_CORNER
   }
   void on_stripe(const lcm::ReceiveBuffer*, const std::string&, const stripe_features_t* m) {
     last_stripe_f = *m;
@@ -505,6 +507,10 @@ struct FullCycleHarness::Impl {
       ++res.grasp_attempts;
       in_extract = true;
     }
+    if (prev == "CLOSE_GRIPPER" && last_front_width > 0) {
+      res.closes.push_back(PlateClose{sim->world().model().gripper_width(), last_front_width,
+                                      m->state == "EXTRACT" ? "" : "backed_out"});
+    }
     if (in_extract && prev == "CLOSE_GRIPPER") {
       const int id = book(m->current_book).truth_id;
       book_in_tcp_at_close = book_in_tcp(id);
@@ -531,6 +537,8 @@ struct FullCycleHarness::Impl {
         ++b.grasp_successes;
         ++res.grasp_successes;
       }
+      if (!res.closes.empty() && res.closes.back().outcome.empty())
+        res.closes.back().outcome = !held ? "not_held" : along.empty() ? "held_alone" : "double_lift";
       trace(std::string("GRASP ") + (held ? (along.empty() ? "held" : "held with other books: FAILED") : "FAILED") +
             ": book id " + std::to_string(b.truth_id) + " is " + (tb ? tb->place : std::string("unknown")) +
             (carried ? " (carried: it moved with the TCP since the close, one plate's contact off this instant)" : ""));

@@ -98,6 +98,17 @@ struct BookRecord {
   double end_s = -1;                 ///< message time it was counted moved
 };
 
+/// One close of the plates on the upper shelf: how much wider than the fore-edge the corner servo measured they
+/// closed, and what became of it. The figures behind grasp.more_than_the_book_m.
+struct PlateClose {
+  double plates_m = 0;     ///< plate distance when the coordinator left CLOSE_GRIPPER (simulation)
+  double fore_edge_m = 0;  ///< the last converged corner servo's front_width_m before the close (> 0)
+  /// "held_alone" (the target and no other book out after EXTRACT), "double_lift" (the target with others),
+  /// "not_held" (the target not in the plates after EXTRACT), "backed_out" (no EXTRACT: the coordinator's
+  /// plate check, or nothing grasped).
+  std::string outcome;
+};
+
 /// What happened in a run.
 struct FullCycleResult {
   std::string end;                   ///< DONE, ABORTED, BUDGET, BOOKS (max_books reached), ERROR
@@ -111,6 +122,7 @@ struct FullCycleResult {
   int holder_standing = 0;  ///< books standing on the holder's ledge after RETREAT_FROM_HOLDER (truth)
   std::vector<BookRecord> books;
   std::vector<GraspDecisionRecord> decisions;
+  std::vector<PlateClose> closes;    ///< every close on the upper shelf with a measured fore-edge
   ground_truth_t final_truth;        ///< latest SIM_GROUND_TRUTH
   double sim_s = 0;                  ///< simulation time used
   double wall_s = 0;                 ///< wall time used (incl. building)

@@ -169,6 +169,9 @@ void accumulate(const SceneOutcome& o, int max_books, const MetricTolerances& to
     if (b.moved && b.end_s >= 0) m->cycle_s.push_back(b.end_s - b.start_s);
   }
   for (double p : r.plan_ms) m->plan_ms.push_back(p);
+  for (const PlateClose& c : r.closes)
+    for (int k = 0; k < 4; ++k)
+      if (c.outcome == kCloseOutcomes[k]) m->plates_over_fore_edge_mm[k].push_back((c.plates_m - c.fore_edge_m) * 1e3);
   const std::string why = failure_reason(r, max_books);
   if (!why.empty()) {
     m->failures.emplace_back(o.seed, why);
@@ -247,6 +250,11 @@ std::string metrics_json(const EvalMetrics& m, const std::string& command) {
   j << "  \"gp_base_error_mm\": {\"x\": " << signed_stats_json(stats_of(m.gp_base_error_mm[0]))
     << ", \"y\": " << signed_stats_json(stats_of(m.gp_base_error_mm[1]))
     << ", \"z\": " << signed_stats_json(stats_of(m.gp_base_error_mm[2])) << "},\n";
+  j << "  \"plates_over_fore_edge_mm\": {";
+  for (int k = 0; k < 4; ++k)
+    j << (k ? ", " : "") << "\"" << kCloseOutcomes[k]
+      << "\": " << signed_stats_json(stats_of(m.plates_over_fore_edge_mm[k]));
+  j << "},\n";
   j << "  \"cycle_s\": " << stats_json(stats_of(m.cycle_s)) << ",\n";
   j << "  \"planning_ms\": " << stats_json(stats_of(m.plan_ms)) << ",\n";
   j << "  \"scene_wall_s\": " << stats_json(stats_of(m.scene_wall_s)) << ",\n";

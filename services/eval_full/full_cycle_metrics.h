@@ -34,6 +34,9 @@ struct Stats {
 /// Statistics of `v` (all zero when empty).
 Stats stats_of(std::vector<double> v);
 
+/// The outcomes of a close (PlateClose::outcome), in the order of EvalMetrics::plates_over_fore_edge_mm.
+inline constexpr const char* kCloseOutcomes[4] = {"held_alone", "double_lift", "not_held", "backed_out"};
+
 /// Everything metrics.json carries. A new field must also be listed in scene_record.cpp (counts() or samples()), or
 /// resumed and merged runs lose it.
 struct EvalMetrics {
@@ -63,6 +66,8 @@ struct EvalMetrics {
   /// gp_error_mm (GP in the arbiter's own cart frame) does not show when the cart frame itself is off.
   std::vector<double> gp_base_error_mm[3];
   std::vector<double> p1_p2_dy_mm, p1_p2_dx_mm;  ///< P2 - P1 per decision
+  /// Plates minus the corner servo's fore-edge at each close (PlateClose), by outcome: kCloseOutcomes[k].
+  std::vector<double> plates_over_fore_edge_mm[4];
   std::vector<double> cycle_s;               ///< per moved book, message time
   std::vector<double> plan_ms;               ///< planner time per request
   std::vector<double> scene_wall_s;          ///< wall time per scene

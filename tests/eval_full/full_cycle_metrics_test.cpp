@@ -182,6 +182,26 @@ TEST(FullCycleMetrics, AGraspThatTookAnotherBookAlongIsADoubleLift) {
   EXPECT_EQ(failure_reason(r, 1), "");
 }
 
+TEST(FullCycleMetrics, PlateClosesAreSortedByWhatBecameOfThem) {
+  // The figures behind grasp.more_than_the_book_m: plates minus the measured fore-edge, per outcome, in mm.
+  SceneOutcome o = done_scene(5);
+  o.result.closes = {{0.0256, 0.0250, "held_alone"}, {0.0310, 0.0250, "double_lift"}, {0.0201, 0.0200, "not_held"},
+                     {0.0470, 0.0250, "backed_out"}, {0.0150, 0.0160, "held_alone"},  {0.0300, 0.0200, ""}};
+  EvalMetrics m;
+  accumulate(o, 0, MetricTolerances{}, &m);
+  ASSERT_EQ(m.plates_over_fore_edge_mm[0].size(), 2u);
+  EXPECT_NEAR(m.plates_over_fore_edge_mm[0][0], 0.6, 1e-9);
+  EXPECT_NEAR(m.plates_over_fore_edge_mm[0][1], -1.0, 1e-9);
+  ASSERT_EQ(m.plates_over_fore_edge_mm[1].size(), 1u);
+  EXPECT_NEAR(m.plates_over_fore_edge_mm[1][0], 6.0, 1e-9);
+  ASSERT_EQ(m.plates_over_fore_edge_mm[2].size(), 1u);
+  ASSERT_EQ(m.plates_over_fore_edge_mm[3].size(), 1u);
+  EXPECT_NEAR(m.plates_over_fore_edge_mm[3][0], 22.0, 1e-9);  // the unfinished close ("") is in none
+  const std::string j = metrics_json(m, "cmd");
+  EXPECT_NE(j.find("\"plates_over_fore_edge_mm\": {\"held_alone\": {\"min\": -1, \"n\": 2"), std::string::npos) << j;
+  EXPECT_NE(j.find("\"double_lift\": {\"min\": 6, \"n\": 1"), std::string::npos) << j;
+}
+
 TEST(FullCycleMetrics, JsonCarriesTheRequiredKeys) {
   EvalMetrics m;
   accumulate(done_scene(3), 0, MetricTolerances{}, &m);

@@ -4,6 +4,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 
 #include "services/eval_full/scene_record.h"
 #include "tests/eval_full/hand_made_scenes.h"
@@ -102,6 +103,24 @@ TEST(SceneRecord, RefusesRunsThatCannotBeMerged) {
   EXPECT_NE(message({a.string(), b.string()}).find("seed 1 is in both"), std::string::npos);
   EXPECT_NE(message({a.string(), c.string()}).find("other options"), std::string::npos);
   EXPECT_NE(message({a.string(), empty.string()}).find("holds no scenes"), std::string::npos);
+}
+
+TEST(SceneRecord, PlateClosesRoundTripAndARecordFromBeforeThemReadsAsNone) {
+  SceneOutcome o = other_scene(14);
+  o.result.closes = {{0.0256, 0.0250, "held_alone"}, {0.0310, 0.0250, "double_lift"}};
+  const SceneRecord r = record_of(o);
+  const SceneRecord back = parse_scene_record(scene_record_yaml(r), "test");
+  EXPECT_EQ(back.metrics.plates_over_fore_edge_mm[0], r.metrics.plates_over_fore_edge_mm[0]);
+  EXPECT_EQ(back.metrics.plates_over_fore_edge_mm[1], r.metrics.plates_over_fore_edge_mm[1]);
+  // A stop 27 record (no plates_over_fore_edge_mm_* keys): read, with no closes.
+  std::string old_text;
+  std::istringstream lines(scene_record_yaml(r));
+  for (std::string line; std::getline(lines, line);)
+    if (line.rfind("plates_over_fore_edge_mm_", 0) != 0) old_text += line + "\n";
+  ASSERT_NE(old_text, scene_record_yaml(r));
+  const SceneRecord before = parse_scene_record(old_text, "stop27/scenes/seed_14.yaml");
+  for (const auto& v : before.metrics.plates_over_fore_edge_mm) EXPECT_TRUE(v.empty());
+  EXPECT_EQ(before.metrics.width_error_mm, r.metrics.width_error_mm);
 }
 
 TEST(SceneRecord, ABadFileIsNamedWithItsKey) {
