@@ -24,9 +24,9 @@ namespace bookgrasp_test {
 namespace {
 
 using bookgrasp::BookPlace;
+using bookgrasp::CycleGeometry;
 using bookgrasp::CycleSettings;
 using bookgrasp::CycleState;
-using bookgrasp::CycleGeometry;
 using bookgrasp::ForeEdges;
 using bookgrasp::holds_more_than_the_book;
 
