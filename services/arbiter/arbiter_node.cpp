@@ -372,9 +372,7 @@ void ArbiterNode::decide(const servo_status_t& msg) {
       last_gp_grasp_ = r.gp;
       last_ps_grasp_ = in.ps;
       corner_at_ps_.reset();
-      for (const ValidationStep& st : r.steps)
-        if (st.rule == "hand corner" && st.passed && in.hand_corner)
-          corner_at_ps_ = CornerAtPs{*ps_, in.hand_corner->z()};
+      if (r.hand_corner_used) corner_at_ps_ = CornerAtPs{*ps_, in.hand_corner->z()};
       last_frame_ = *frame_;
       settle_start_utime_ = -1;
       open_attempt();

@@ -119,6 +119,7 @@ CombinationResult combine(const CombinationInputs& in, const CombinationToleranc
                              "R triangulated " + mm(dz) + " from the model's front plane: not used"));
     } else {
       hand = true;
+      r.hand_corner_used = true;
       r.steps.push_back(step(
           "hand corner", dy, tol.hand_corner_max_y_from_p2, true,
           "R triangulated by the hand camera: P2.x " + mm(p2.x()) + " -> " + mm(h.x()) + " at its depth " + mm(h.z())));

@@ -100,6 +100,7 @@ struct CombinationResult {
   GraspOutcome outcome = GraspOutcome::kNoGrasp;
   Eigen::Vector3d gp = Eigen::Vector3d::Zero();  ///< GP = (P2.x, P2.y, P1.z) after validation
   bool p1_valid = false;                         ///< P1 passed the PS check and was used
+  bool hand_corner_used = false;                 ///< CombinationInputs::hand_corner gave P2.x and GP.z
   int next_rank = 0;                             ///< for kNextRegion: the rank to ask BwH for
   /// Where BwH should start servoing: P1 if valid, else PS (Section 3.1) in X and Y. Its Z is the depth of the
   /// book's front the servo should assume: P1.z if valid, else front_depth_without_p1 (NaN when unknown).
