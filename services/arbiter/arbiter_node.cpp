@@ -73,6 +73,7 @@ ArbiterSettings ArbiterSettings::from_config(const Config& root) {
   s.tolerances.use_hand_corner = root.get<bool>("hand_corner.enabled");
   s.tolerances.hand_corner_max_y_from_p2 = root.get_double("hand_corner.max_y_from_p2_m", 0.0, 0.1);
   s.tolerances.p2_ps_y = root.get_double("tolerances.p2_measured_ps_y_m", 0.0, 0.2);
+  s.tolerances.raised_bwh_start_x = root.get_double("tolerances.raised_bwh_start_m", 0.0, 0.3);
   s.use_stereo_front = root.get<bool>("stereo_front.enabled");
   const std::vector<double> band = root.get_vector("stereo_front.probe_left_of_ps_m", 2);
   if (!(band[0] >= 0 && band[0] < band[1] && band[1] <= 0.1))
@@ -386,6 +387,11 @@ void ArbiterNode::decide(const servo_status_t& msg) {
       p1_astray_at_ps_ = ps_;
       open_attempt();
       break;
+    case GraspOutcome::kRaiseBwhStart:
+      m.reason = "RAISE_BWH_START: " + last;
+      raised_at_ps_ = ps_;
+      open_attempt();
+      break;
     case GraspOutcome::kNoGrasp:
       m.reason = "NO_GRASP: " + last;
       open_attempt();
@@ -403,6 +409,7 @@ CombinationInputs ArbiterNode::common_inputs() const {
   in.ps = to_grasp(*ps_);
   in.ps_measured = ps_measured_;
   in.p1_led_astray = p1_astray_at_ps_ && *p1_astray_at_ps_ == *ps_;
+  in.bwh_start_raised = raised_at_ps_ && *raised_at_ps_ == *ps_;
   if (corner_at_ps_ && corner_at_ps_->ps == *ps_) in.earlier_corner_z = corner_at_ps_->z;
   in.front_z_fallback = s_.book_front_z;
   in.stereo_front_z = stereo_front_z(in.ps);

@@ -136,6 +136,9 @@ class ArbiterNode : public Component {
   /// The PS (base) at which a valid P1 led BwH to a left neighbour's corner (GraspOutcome::kP1LedAstray): at the
   /// same PS, P1 is not used again.
   std::optional<Eigen::Vector3d> p1_astray_at_ps_;
+  /// The PS (base) at which BwH from PS found a shorter left neighbour's corner (GraspOutcome::kRaiseBwhStart): at
+  /// the same PS, BwH starts higher.
+  std::optional<Eigen::Vector3d> raised_at_ps_;
   /// R's depth (grasp Z) the corner servo triangulated for the last GRASP, and the PS (base) it was decided at:
   /// CombinationInputs::earlier_corner_z while PS stays that one (a failed attempt at the same book).
   struct CornerAtPs {

@@ -30,6 +30,8 @@ std::string outcome_name(GraspOutcome o) {
     case GraspOutcome::kNextRegion: return "NEXT_REGION";
     case GraspOutcome::kP1LedAstray:
       return "P1_LED_ASTRAY";
+    case GraspOutcome::kRaiseBwhStart:
+      return "RAISE_BWH_START";
     case GraspOutcome::kNoGrasp: return "NO_GRASP";
   }
   return "?";
@@ -64,7 +66,10 @@ std::optional<double> front_depth_without_p1(const CombinationInputs& in, const 
   return std::nullopt;
 }
 
-CombinationResult validate_p1(const CombinationInputs& in, const CombinationTolerances& tol) {
+namespace {
+
+// Section 3.1 as the paper writes it (with P1_LED_ASTRAY's exception).
+CombinationResult validate_p1_against_ps(const CombinationInputs& in, const CombinationTolerances& tol) {
   CombinationResult r;
   r.bwh_start = in.ps;
   if (!in.ps.allFinite()) return fail(r, "inputs", "PS is not finite: no reference for the right-most book");
@@ -94,6 +99,18 @@ CombinationResult validate_p1(const CombinationInputs& in, const CombinationTole
                            "P1 invalid (" + mm(d) + " from PS, e.g. a thin book BwS missed): ignore BwS, BwH "
                            "starts from PS"));
   }
+  return r;
+}
+
+}  // namespace
+
+CombinationResult validate_p1(const CombinationInputs& in, const CombinationTolerances& tol) {
+  CombinationResult r = validate_p1_against_ps(in, tol);
+  if (r.p1_valid || !in.bwh_start_raised || !(tol.raised_bwh_start_x > 0) || !r.bwh_start.allFinite()) return r;
+  r.bwh_start.x() += tol.raised_bwh_start_x;
+  r.steps.push_back(step("BwH start raised", tol.raised_bwh_start_x, tol.raised_bwh_start_x, true,
+                         "BwH from PS found a shorter left neighbour's corner at this PS before: it starts " +
+                             mm(tol.raised_bwh_start_x) + " higher, where a tall right-most book's corner lies"));
   return r;
 }
 
@@ -163,6 +180,25 @@ CombinationResult combine(const CombinationInputs& in, const CombinationToleranc
       return r;
     }
     r.steps.push_back(step("P2.y vs measured PS.y", dps, tol.p2_ps_y, true, "P2 at the stripe end's book"));
+  }
+  // Not in the paper: the same measured-PS test without a valid P1. BwH started from PS at the stripe's height and
+  // centred a corner far left of it: a shorter left neighbour's, the tall right-most book's corner above the view.
+  if (!r.p1_valid && in.ps_measured && tol.p2_ps_y > 0 && tol.raised_bwh_start_x > 0) {
+    const double dps = p2.y() - in.ps.y();
+    if (dps < -tol.p2_ps_y && !in.bwh_start_raised) {
+      r.steps.push_back(step("P2.y vs measured PS.y", dps, tol.p2_ps_y, false,
+                             "P2 is " + mm(-dps) +
+                                 " left of the stripe end without a valid P1: a shorter left neighbour's corner; the "
+                                 "next attempt starts BwH " +
+                                 mm(tol.raised_bwh_start_x) + " higher"));
+      r.outcome = GraspOutcome::kRaiseBwhStart;
+      return r;
+    }
+    r.steps.push_back(step("P2.y vs measured PS.y", dps, tol.p2_ps_y, dps >= -tol.p2_ps_y,
+                           dps >= -tol.p2_ps_y ? "P2 at the stripe end's book"
+                                               : "P2 still " + mm(-dps) +
+                                                     " left of the stripe end from the raised start: the paper's "
+                                                     "rules decide"));
   }
 
   if (std::abs(dy) < tol.y) {

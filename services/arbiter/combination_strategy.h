@@ -42,6 +42,11 @@ struct CombinationTolerances {
   /// beside a taller one: P1 on the taller book passed the PS check). No grasp; the next attempt ignores P1 and
   /// starts BwH from PS (CombinationInputs::p1_led_astray). 0 = off (the paper accepts such a P2).
   double p2_ps_y = 0.0;
+  /// Not in the paper: without a valid P1 and with a measured PS, a P2 more than `p2_ps_y` left of PS is a shorter
+  /// left neighbour's corner: the right-most book is tall and its corner lies above the hand camera's view from PS
+  /// at the stripe's height. No grasp (kRaiseBwhStart); the next check at this PS starts BwH this much higher (X).
+  /// Once raised, such a P2 is judged by the paper's rules. 0 = off (the paper accepts such a P2). Needs p2_ps_y > 0.
+  double raised_bwh_start_x = 0.0;
 };
 
 /// One decision of the strategy, with the numbers it was made on.
@@ -61,6 +66,9 @@ enum class GraspOutcome {
   /// P1 led BwH to a left neighbour's corner (CombinationTolerances::p2_ps_y): no grasp; the next attempt starts
   /// BwH from PS with P1 ignored.
   kP1LedAstray,
+  /// Without a valid P1, BwH from PS found a corner left of the measured PS (CombinationTolerances::
+  /// raised_bwh_start_x): no grasp; the next attempt starts BwH from PS raised in X.
+  kRaiseBwhStart,
 };
 
 /// Inputs of one decision. P1 from BwS (may be missing), PS from BSwH or the
@@ -93,6 +101,9 @@ struct CombinationInputs {
   /// At this PS, a valid P1 led BwH to a corner more than CombinationTolerances::p2_ps_y left of it before: P1 is
   /// not used (BwH starts from PS).
   bool p1_led_astray = false;
+  /// At this PS, BwH from PS (no valid P1) found a corner more than CombinationTolerances::p2_ps_y left of it before:
+  /// BwH starts CombinationTolerances::raised_bwh_start_x higher.
+  bool bwh_start_raised = false;
 };
 
 /// Result: GP (grasp frame) and every step.

@@ -1136,9 +1136,10 @@ void LibraryCycle::handle_grasp_decision(const DecisionEvent& d) {
     rank_ = d.next_rank;
     message_ = d.reason;
     succeed(CycleState::kMoveToBwhStart);
-  } else if (d.outcome == "P1_LED_ASTRAY") {
-    // Not a failed attempt: BwS's P1 took BwH to a neighbour, and the arbiter's next P1 check sends BwH from PS. It
-    // answers so once per PS, so this cannot repeat without bound. The servo is cancelled as after a failure.
+  } else if (d.outcome == "P1_LED_ASTRAY" || d.outcome == "RAISE_BWH_START") {
+    // Not a failed attempt: BwH centred a neighbour's corner, and the arbiter's next P1 check sends BwH from PS
+    // (P1_LED_ASTRAY: BwS's P1 took it there) or from higher above PS (RAISE_BWH_START: a tall right-most book). It
+    // answers each once per PS, so this cannot repeat without bound. The servo is cancelled as after a failure.
     out_.push_back(make_request(CycleRequest::Kind::kServoCancel));
     message_ = d.reason + " (attempt " + std::to_string(attempt_) + " goes on)";
     succeed(CycleState::kPark);

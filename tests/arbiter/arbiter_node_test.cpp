@@ -381,6 +381,32 @@ TEST_F(ArbiterNodeTest, AP1ThatLedBwhToTheNeighbourIsNotUsedAgainAtThatPs) {
   EXPECT_TRUE(starts_with(out.got[5].reason, "P1_VALID")) << out.got[5].reason;
 }
 
+// A tall right-most book: P1 failed the PS check, BwH from PS at the stripe's height centred the shorter left
+// neighbour's corner 25 mm left of the measured PS. No grasp; the next P1 check at the same PS starts BwH higher
+// (tolerances.raised_bwh_start_m), from where the tall book's own corner is grasped.
+TEST_F(ArbiterNodeTest, ANeighbourCornerFromPsRaisesTheNextBwhStart) {
+  // P1 base y -0.325 -> grasp 0.275, 20 mm from PS.y 0.255: invalid, BwH from PS.
+  first_run({0.61, -0.325, 0.25}, {0.45, -0.305, 0.10});
+  ASSERT_EQ(out.got.size(), 2u);
+  EXPECT_TRUE(starts_with(out.got[1].reason, "P1_INVALID")) << out.got[1].reason;
+  // P2 grasp (0.16, 0.230): 25 mm left of the measured PS.
+  corner_converged(5000, 2, 0, {0.45, -0.28, 0.16});
+  ASSERT_EQ(out.got.size(), 3u);
+  EXPECT_TRUE(starts_with(out.got[2].reason, "RAISE_BWH_START: P2 is 25.0 mm left of the stripe end"))
+      << out.got[2].reason;
+  EXPECT_FALSE(out.got[2].valid);
+  // The next attempt's P1 check: BwH starts from PS 100 mm higher (grasp X 0.10 -> 0.20), same Y and depth.
+  send("BOOK_CORNER_STEREO", corner(7000, "god", true, {0.61, -0.325, 0.25}));
+  ASSERT_EQ(out.got.size(), 4u);
+  EXPECT_TRUE(starts_with(out.got[3].reason, "P1_INVALID")) << out.got[3].reason;
+  expect_vec(out.got[3].gp_grasp, {0.20, 0.255, 0.01}, "BwH start = PS raised, front depth");
+  // From there BwH centres the tall book's corner (grasp (0.30, 0.253)): grasped.
+  corner_converged(8000, 3, 0, {0.45, -0.303, 0.30});
+  ASSERT_EQ(out.got.size(), 5u);
+  EXPECT_TRUE(starts_with(out.got[4].reason, "GRASP")) << out.got[4].reason;
+  expect_vec(out.got[4].gp_grasp, {0.30, 0.253, 0.01}, "GP at the tall book's corner");
+}
+
 TEST_F(ArbiterNodeTest, NoRegionLeftGivesNoGrasp) {
   first_run({0.61, -0.30, 0.25}, {0.45, -0.305, 0.10});
   corner_converged(5000, 2, 2, {0.45, -0.33, 0.25});

@@ -365,6 +365,63 @@ TEST(CombinationStrategy, AP2FarLeftOfAMeasuredPsIsTheNeighbourP1LedBwhTo) {
   EXPECT_EQ(check.steps.back().rule, "P1 led BwH astray");
 }
 
+TEST(CombinationStrategy, WithoutAValidP1AP2FarLeftOfAMeasuredPsRaisesTheNextBwhStart) {
+  // A tall right-most book: BwS's P1 failed the PS check, BwH started from PS (Y 0.100) at the stripe's height and
+  // centred the shorter left neighbour's corner 25 mm left of the measured PS (far_cart seed 5070's case).
+  CombinationTolerances tol = kTol;
+  tol.p2_ps_y = 0.010;
+  tol.raised_bwh_start_x = 0.10;
+  CombinationInputs in;
+  in.ps = kPs;
+  in.ps_measured = true;
+  in.front_z_fallback = 0.42;
+  in.p2 = V(0.12, 0.075, 0.45);
+  const CombinationResult r = combine(in, tol);
+  EXPECT_EQ(r.outcome, GraspOutcome::kRaiseBwhStart);
+  EXPECT_EQ(outcome_name(r.outcome), "RAISE_BWH_START");
+  ASSERT_FALSE(r.steps.empty());
+  EXPECT_EQ(r.steps.back().rule, "P2.y vs measured PS.y");
+  EXPECT_NEAR(r.steps.back().value, -0.025, 1e-12);
+  EXPECT_NE(r.steps.back().decision.find("starts BwH 100.0 mm higher"), std::string::npos) << r.steps.back().decision;
+  // An invalid P1 (on the shorter neighbour, 20 mm left of PS) changes nothing.
+  CombinationInputs bad_p1 = in;
+  bad_p1.p1 = V(0.11, 0.080, 0.40);
+  EXPECT_EQ(combine(bad_p1, tol).outcome, GraspOutcome::kRaiseBwhStart);
+  // A P2 9 mm left of PS is the book at the stripe end: grasped there.
+  CombinationInputs near = in;
+  near.p2 = V(0.12, 0.091, 0.45);
+  EXPECT_EQ(combine(near, tol).outcome, GraspOutcome::kGrasp);
+  // The rule off, or PS the estimate GP.y - BW: the paper's rule (P2 left of PS) grasps the neighbour's corner.
+  CombinationTolerances off = tol;
+  off.raised_bwh_start_x = 0.0;
+  EXPECT_EQ(combine(in, off).outcome, GraspOutcome::kGrasp);
+  CombinationInputs estimated = in;
+  estimated.ps_measured = false;
+  EXPECT_EQ(combine(estimated, tol).outcome, GraspOutcome::kGrasp);
+
+  // The next attempt at the same PS: BwH starts from PS raised by 100 mm in X, same Y and depth.
+  in.bwh_start_raised = true;
+  const CombinationResult check = validate_p1(in, tol);
+  EXPECT_FALSE(check.p1_valid);
+  EXPECT_NEAR(check.bwh_start.x(), kPs.x() + 0.10, 1e-12);
+  EXPECT_NEAR(check.bwh_start.y(), kPs.y(), 1e-12);
+  EXPECT_NEAR(check.bwh_start.z(), 0.42, 1e-12);
+  ASSERT_FALSE(check.steps.empty());
+  EXPECT_EQ(check.steps.back().rule, "BwH start raised");
+  // From there, the tall book's corner at the stripe end is grasped; the same far-left P2 again goes to the paper's
+  // rules (no second raise).
+  in.p2 = V(0.23, 0.098, 0.45);
+  const CombinationResult tall = combine(in, tol);
+  EXPECT_EQ(tall.outcome, GraspOutcome::kGrasp);
+  EXPECT_TRUE(tall.gp.isApprox(V(0.23, 0.098, 0.42), 1e-12)) << tall.gp.transpose();
+  in.p2 = V(0.12, 0.075, 0.45);
+  EXPECT_EQ(combine(in, tol).outcome, GraspOutcome::kGrasp);
+  // A valid P1 never raises the start.
+  CombinationInputs valid = in;
+  valid.p1 = V(0.22, 0.099, 0.40);
+  EXPECT_TRUE(validate_p1(valid, tol).bwh_start.isApprox(V(0.22, 0.099, 0.40), 1e-12));
+}
+
 TEST(CombinationStrategy, NextPsAfterAGrasp) {
   // GP.y = 0.105, a 2.3 cm book: the next book's right edge is expected at 0.082.
   const V ps = next_ps(kPs, V(0.1, 0.105, 0.4), 0.023);

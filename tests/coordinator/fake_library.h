@@ -72,7 +72,8 @@ class FakeLibrary {
   std::map<std::string, int> plan_failures;  ///< state name -> failures of the next plans there
   int next_region_once = 0;                  ///< BwH rank 0 answers NEXT_REGION this many times
   int no_grasp_once = 0;                     ///< BwH answers NO_GRASP this many times
-  int p1_led_astray_once = 0;                ///< BwH answers P1_LED_ASTRAY this many times
+  int p1_led_astray_once = 0;                ///< BwH answers `reroute_outcome` this many times
+  std::string reroute_outcome = "P1_LED_ASTRAY";  ///< or RAISE_BWH_START: both re-route BwH within the attempt
   int missed_grasps = 0;                     ///< the gripper closes on nothing this many times
   /// The next N closes on the shelf take the right-most book and the one left of it: the plates stop at both
   /// books' width (from the first's right cover to the second's left one)
@@ -392,7 +393,7 @@ class FakeLibrary {
               d.next_rank = 1;
             } else if (p1_led_astray_once > 0) {
               --p1_led_astray_once;
-              d.outcome = "P1_LED_ASTRAY";
+              d.outcome = reroute_outcome;
             } else if (no_grasp_once > 0 || upper.empty()) {
               if (no_grasp_once > 0) --no_grasp_once;
               d.outcome = "NO_GRASP";

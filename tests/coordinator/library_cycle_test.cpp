@@ -534,27 +534,33 @@ TEST(LibraryCycle, BadDepthKeysNameTheKey) {
   }
 }
 
-TEST(LibraryCycle, P1LedAstrayParksAndChecksP1AgainWithinTheSameAttempt) {
-  FakeLibrary w(three_books());
-  w.p1_led_astray_once = 1;
-  LibraryCycle cycle(settings(), std::nullopt);
-  w.run(cycle, [&] { return done_or_aborted(cycle); });
-  ASSERT_EQ(cycle.state(), CycleState::kDone) << cycle.status().message;
-  EXPECT_EQ(cycle.progress().books_moved, 3);
-  EXPECT_EQ(cycle.progress().failures, 0) << "a re-routed corner search is no failed attempt";
-  EXPECT_EQ(slice(w.states, "WAIT_DECISION", 3), (std::vector<std::string>{"WAIT_DECISION", "PARK", "WAIT_P1_CHECK"}));
-  // The servo was cancelled after the answer (one cancel more than the same run without it); the attempt stayed 1.
-  const auto cancels = [](const FakeLibrary& f) {
-    return std::count_if(f.requests.begin(), f.requests.end(),
-                         [](const CycleRequest& r) { return r.kind == CycleRequest::Kind::kServoCancel; });
-  };
-  FakeLibrary plain(three_books());
-  LibraryCycle plain_cycle(settings(), std::nullopt);
-  plain.run(plain_cycle, [&] { return done_or_aborted(plain_cycle); });
-  EXPECT_EQ(cancels(w), cancels(plain) + 1);
-  EXPECT_TRUE(std::any_of(w.messages.begin(), w.messages.end(), [](const std::string& m) {
-    return m.rfind("P1_LED_ASTRAY: fake arbiter (attempt 1 goes on)", 0) == 0;
-  }));
+TEST(LibraryCycle, AReRoutedCornerSearchParksAndChecksP1AgainWithinTheSameAttempt) {
+  // P1_LED_ASTRAY (BwH from PS next) and RAISE_BWH_START (BwH from higher above PS next) are handled alike.
+  for (const std::string outcome : {"P1_LED_ASTRAY", "RAISE_BWH_START"}) {
+    SCOPED_TRACE(outcome);
+    FakeLibrary w(three_books());
+    w.p1_led_astray_once = 1;
+    w.reroute_outcome = outcome;
+    LibraryCycle cycle(settings(), std::nullopt);
+    w.run(cycle, [&] { return done_or_aborted(cycle); });
+    ASSERT_EQ(cycle.state(), CycleState::kDone) << cycle.status().message;
+    EXPECT_EQ(cycle.progress().books_moved, 3);
+    EXPECT_EQ(cycle.progress().failures, 0) << "a re-routed corner search is no failed attempt";
+    EXPECT_EQ(slice(w.states, "WAIT_DECISION", 3),
+              (std::vector<std::string>{"WAIT_DECISION", "PARK", "WAIT_P1_CHECK"}));
+    // The servo was cancelled after the answer (one cancel more than the same run without it); the attempt stayed 1.
+    const auto cancels = [](const FakeLibrary& f) {
+      return std::count_if(f.requests.begin(), f.requests.end(),
+                           [](const CycleRequest& r) { return r.kind == CycleRequest::Kind::kServoCancel; });
+    };
+    FakeLibrary plain(three_books());
+    LibraryCycle plain_cycle(settings(), std::nullopt);
+    plain.run(plain_cycle, [&] { return done_or_aborted(plain_cycle); });
+    EXPECT_EQ(cancels(w), cancels(plain) + 1);
+    EXPECT_TRUE(std::any_of(w.messages.begin(), w.messages.end(), [&](const std::string& m) {
+      return m.rfind(outcome + ": fake arbiter (attempt 1 goes on)", 0) == 0;
+    }));
+  }
 }
 
 TEST(LibraryCycle, NoGraspFromTheArbiterStartsANewAttempt) {
