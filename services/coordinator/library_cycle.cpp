@@ -650,6 +650,7 @@ void LibraryCycle::book_done(bool handed_over) {
     message_ = "book " + std::to_string(b.index) + where;
   }
   attempt_ = 1;
+  rerouting_ = false;
   narrow_after_more_than_the_book_ = false;
 }
 
@@ -693,7 +694,8 @@ void LibraryCycle::enter(CycleState s) {
       start_planned_joints(s_.park_joints);
       break;
     case CycleState::kWaitP1Check:
-      stripe_done_this_attempt_ = false;
+      stripe_done_this_attempt_ = rerouting_;
+      rerouting_ = false;
       early_decision_.reset();
       set_deadline(s_.decision_timeout_s);
       break;
@@ -905,6 +907,7 @@ void LibraryCycle::fail(const std::string& reason) {
       return;
     }
     attempt_ += 1;
+    rerouting_ = false;
     message_ = "attempt " + std::to_string(attempt_) + " at book " + std::to_string(progress_.books_moved) +
                " after: " + reason;
     const bool inside = in(state_, {CycleState::kInsert, CycleState::kCloseGripper});
@@ -1141,6 +1144,7 @@ void LibraryCycle::handle_grasp_decision(const DecisionEvent& d) {
     // (P1_LED_ASTRAY: BwS's P1 took it there) or from higher above PS (RAISE_BWH_START: a tall right-most book). It
     // answers each once per PS, so this cannot repeat without bound. The servo is cancelled as after a failure.
     out_.push_back(make_request(CycleRequest::Kind::kServoCancel));
+    rerouting_ = true;
     message_ = d.reason + " (attempt " + std::to_string(attempt_) + " goes on)";
     succeed(CycleState::kPark);
   } else {

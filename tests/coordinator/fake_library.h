@@ -74,6 +74,8 @@ class FakeLibrary {
   int no_grasp_once = 0;                     ///< BwH answers NO_GRASP this many times
   int p1_led_astray_once = 0;                ///< BwH answers `reroute_outcome` this many times
   std::string reroute_outcome = "P1_LED_ASTRAY";  ///< or RAISE_BWH_START: both re-route BwH within the attempt
+  bool p1_absent_after_reroute = false;  ///< the P1 check after a re-route has no P1 (BwS missed the book there)
+  bool rerouted = false;                 ///< a re-route was answered and its P1 check not yet made
   int missed_grasps = 0;                     ///< the gripper closes on nothing this many times
   /// The next N closes on the shelf take the right-most book and the one left of it: the plates stop at both
   /// books' width (from the first's right cover to the second's left one)
@@ -155,7 +157,10 @@ class FakeLibrary {
     for (auto& d : delayed) handle(cycle, d());
     // The arbiter answers each stereo frame (5 Hz) while the cycle waits for a P1 check.
     if (cycle.state() == bookgrasp::CycleState::kWaitP1Check && (t / 10000) % 20 == 0)
+    {
       handle(cycle, cycle.on_decision(p1_check(0)));
+      if (cycle.state() != bookgrasp::CycleState::kWaitP1Check) rerouted = false;
+    }
     const bool librarian = cycle.state() == bookgrasp::CycleState::kWaitBookTaken && librarian_answers;
     if ((cycle.state() == bookgrasp::CycleState::kWaitUser && user_answers) || librarian) {
       if (wait_user_since_ < 0) wait_user_since_ = t;
@@ -229,7 +234,7 @@ class FakeLibrary {
     bookgrasp::DecisionEvent d;
     d.utime = t;
     d.request_id = request_id;
-    d.p1_present = !upper.empty();
+    d.p1_present = !upper.empty() && !(rerouted && p1_absent_after_reroute);
     if (d.p1_present) d.p1_grasp = Eigen::Vector3d(upper.front().height, upper.front().right_y, kP1FrontZ);
     d.ps_present = ps.has_value();
     if (ps) d.ps_grasp = *ps;
@@ -238,7 +243,7 @@ class FakeLibrary {
     } else if (!upper.empty() && invalid_p1_front_z) {
       d.outcome = "P1_INVALID";
       d.gp_grasp = Eigen::Vector3d(ps->x(), ps->y(), *invalid_p1_front_z);
-    } else if (!upper.empty()) {
+    } else if (d.p1_present) {
       d.outcome = "P1_VALID";
       d.gp_grasp = Eigen::Vector3d(upper.front().height, upper.front().right_y, kP1FrontZ);
     } else {
@@ -394,6 +399,7 @@ class FakeLibrary {
             } else if (p1_led_astray_once > 0) {
               --p1_led_astray_once;
               d.outcome = reroute_outcome;
+              rerouted = true;
             } else if (no_grasp_once > 0 || upper.empty()) {
               if (no_grasp_once > 0) --no_grasp_once;
               d.outcome = "NO_GRASP";

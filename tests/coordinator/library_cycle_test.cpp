@@ -563,6 +563,29 @@ TEST(LibraryCycle, AReRoutedCornerSearchParksAndChecksP1AgainWithinTheSameAttemp
   }
 }
 
+// After a re-route the stripe end stands measured and BwH just saw the books there: a P1 check without P1 (BwS missed
+// the book in that frame) starts BwH at once. Before, it ran the stripe servo again, whose new PS lost the arbiter's
+// memory of the re-route (far_cart seed 5144: RAISE_BWH_START twice at two PS 0.2 mm apart).
+TEST(LibraryCycle, AP1CheckWithoutP1AfterAReRouteStartsBwhWithoutTheStripeServo) {
+  const auto stripe_moves = [](const FakeLibrary& f) {
+    return std::count(f.states.begin(), f.states.end(), "MOVE_TO_STRIPE_START");
+  };
+  FakeLibrary plain(three_books());
+  LibraryCycle plain_cycle(settings(), std::nullopt);
+  plain.run(plain_cycle, [&] { return done_or_aborted(plain_cycle); });
+  FakeLibrary w(three_books());
+  w.p1_led_astray_once = 1;
+  w.reroute_outcome = "RAISE_BWH_START";
+  w.p1_absent_after_reroute = true;
+  LibraryCycle cycle(settings(), std::nullopt);
+  w.run(cycle, [&] { return done_or_aborted(cycle); });
+  ASSERT_EQ(cycle.state(), CycleState::kDone) << cycle.status().message;
+  EXPECT_EQ(cycle.progress().books_moved, 3);
+  EXPECT_EQ(slice(w.states, "WAIT_DECISION", 4),
+            (std::vector<std::string>{"WAIT_DECISION", "PARK", "WAIT_P1_CHECK", "MOVE_TO_BWH_START"}));
+  EXPECT_EQ(stripe_moves(w), stripe_moves(plain));
+}
+
 TEST(LibraryCycle, NoGraspFromTheArbiterStartsANewAttempt) {
   FakeLibrary w(three_books());
   w.no_grasp_once = 1;
