@@ -74,8 +74,8 @@ class FakeLibrary {
   int no_grasp_once = 0;                     ///< BwH answers NO_GRASP this many times
   int p1_led_astray_once = 0;                ///< BwH answers `reroute_outcome` this many times
   std::string reroute_outcome = "P1_LED_ASTRAY";  ///< or RAISE_BWH_START: both re-route BwH within the attempt
-  bool p1_absent_after_reroute = false;  ///< the P1 check after a re-route has no P1 (BwS missed the book there)
-  bool rerouted = false;                 ///< a re-route was answered and its P1 check not yet made
+  bool p1_absent_after_reroute = false;      ///< the P1 check after a re-route has no P1 (BwS missed the book there)
+  bool rerouted = false;                     ///< a re-route was answered and its P1 check not yet made
   int missed_grasps = 0;                     ///< the gripper closes on nothing this many times
   /// The next N closes on the shelf take the right-most book and the one left of it: the plates stop at both
   /// books' width (from the first's right cover to the second's left one)
@@ -156,8 +156,7 @@ class FakeLibrary {
     handle(cycle, cycle.on_arm(e));
     for (auto& d : delayed) handle(cycle, d());
     // The arbiter answers each stereo frame (5 Hz) while the cycle waits for a P1 check.
-    if (cycle.state() == bookgrasp::CycleState::kWaitP1Check && (t / 10000) % 20 == 0)
-    {
+    if (cycle.state() == bookgrasp::CycleState::kWaitP1Check && (t / 10000) % 20 == 0) {
       handle(cycle, cycle.on_decision(p1_check(0)));
       if (cycle.state() != bookgrasp::CycleState::kWaitP1Check) rerouted = false;
     }
