@@ -13,6 +13,14 @@ namespace {
 
 constexpr double kNan = std::numeric_limits<double>::quiet_NaN();
 
+/// Two stripe ends this near (base, m) are the same book's: the stripe servo measures one end again within ~0.2 mm
+/// (far_cart seed 5144), the next book's lies a book's width (>= 12 mm) away.
+constexpr double kSameStripeEndM = 0.003;
+
+bool same_stripe_end(const std::optional<Eigen::Vector3d>& remembered, const Eigen::Vector3d& ps) {
+  return remembered && (*remembered - ps).norm() <= kSameStripeEndM;
+}
+
 std::string mm(double metres) {
   char buf[32];
   std::snprintf(buf, sizeof(buf), "%.1f mm", metres * 1000.0);
@@ -408,8 +416,8 @@ CombinationInputs ArbiterNode::common_inputs() const {
   if (p1b) in.p1 = to_grasp(*p1b);
   in.ps = to_grasp(*ps_);
   in.ps_measured = ps_measured_;
-  in.p1_led_astray = p1_astray_at_ps_ && *p1_astray_at_ps_ == *ps_;
-  in.bwh_start_raised = raised_at_ps_ && *raised_at_ps_ == *ps_;
+  in.p1_led_astray = same_stripe_end(p1_astray_at_ps_, *ps_);
+  in.bwh_start_raised = same_stripe_end(raised_at_ps_, *ps_);
   if (corner_at_ps_ && corner_at_ps_->ps == *ps_) in.earlier_corner_z = corner_at_ps_->z;
   in.front_z_fallback = s_.book_front_z;
   in.stereo_front_z = stereo_front_z(in.ps);

@@ -134,10 +134,10 @@ class ArbiterNode : public Component {
   std::optional<Eigen::Vector3d> ps_;          ///< base
   bool ps_measured_ = false;                   ///< ps_ is the stripe servo's end, not GP.y - BW
   /// The PS (base) at which a valid P1 led BwH to a left neighbour's corner (GraspOutcome::kP1LedAstray): at the
-  /// same PS, P1 is not used again.
+  /// same PS (within 3 mm: the stripe end measured again), P1 is not used again.
   std::optional<Eigen::Vector3d> p1_astray_at_ps_;
   /// The PS (base) at which BwH from PS found a shorter left neighbour's corner (GraspOutcome::kRaiseBwhStart): at
-  /// the same PS, BwH starts higher.
+  /// the same PS (within 3 mm), BwH starts higher.
   std::optional<Eigen::Vector3d> raised_at_ps_;
   /// R's depth (grasp Z) the corner servo triangulated for the last GRASP, and the PS (base) it was decided at:
   /// CombinationInputs::earlier_corner_z while PS stays that one (a failed attempt at the same book).

@@ -185,20 +185,20 @@ CombinationResult combine(const CombinationInputs& in, const CombinationToleranc
   // centred a corner far left of it: a shorter left neighbour's, the tall right-most book's corner above the view.
   if (!r.p1_valid && in.ps_measured && tol.p2_ps_y > 0 && tol.raised_bwh_start_x > 0) {
     const double dps = p2.y() - in.ps.y();
-    if (dps < -tol.p2_ps_y && !in.bwh_start_raised) {
+    if (dps < -tol.p2_ps_y) {
+      // Once raised, no second raise: a failed attempt (the next one starts from the raised start again).
+      r.outcome = in.bwh_start_raised ? GraspOutcome::kNoGrasp : GraspOutcome::kRaiseBwhStart;
       r.steps.push_back(step("P2.y vs measured PS.y", dps, tol.p2_ps_y, false,
-                             "P2 is " + mm(-dps) +
-                                 " left of the stripe end without a valid P1: a shorter left neighbour's corner; the "
-                                 "next attempt starts BwH " +
-                                 mm(tol.raised_bwh_start_x) + " higher"));
-      r.outcome = GraspOutcome::kRaiseBwhStart;
+                             in.bwh_start_raised
+                                 ? "P2 is still " + mm(-dps) +
+                                       " left of the stripe end from the raised start: a neighbour's corner, no grasp"
+                                 : "P2 is " + mm(-dps) +
+                                       " left of the stripe end without a valid P1: a shorter left neighbour's "
+                                       "corner; the next attempt starts BwH " +
+                                       mm(tol.raised_bwh_start_x) + " higher"));
       return r;
     }
-    r.steps.push_back(step("P2.y vs measured PS.y", dps, tol.p2_ps_y, dps >= -tol.p2_ps_y,
-                           dps >= -tol.p2_ps_y ? "P2 at the stripe end's book"
-                                               : "P2 still " + mm(-dps) +
-                                                     " left of the stripe end from the raised start: the paper's "
-                                                     "rules decide"));
+    r.steps.push_back(step("P2.y vs measured PS.y", dps, tol.p2_ps_y, true, "P2 at the stripe end's book"));
   }
 
   if (std::abs(dy) < tol.y) {

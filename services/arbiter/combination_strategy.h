@@ -45,7 +45,8 @@ struct CombinationTolerances {
   /// Not in the paper: without a valid P1 and with a measured PS, a P2 more than `p2_ps_y` left of PS is a shorter
   /// left neighbour's corner: the right-most book is tall and its corner lies above the hand camera's view from PS
   /// at the stripe's height. No grasp (kRaiseBwhStart); the next check at this PS starts BwH this much higher (X).
-  /// Once raised, such a P2 is judged by the paper's rules. 0 = off (the paper accepts such a P2). Needs p2_ps_y > 0.
+  /// Once raised, such a P2 again gets no grasp (kNoGrasp: a failed attempt; the next one starts raised as well).
+  /// 0 = off (the paper accepts such a P2). Needs p2_ps_y > 0.
   double raised_bwh_start_x = 0.0;
 };
 

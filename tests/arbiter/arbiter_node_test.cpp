@@ -374,9 +374,9 @@ TEST_F(ArbiterNodeTest, AP1ThatLedBwhToTheNeighbourIsNotUsedAgainAtThatPs) {
   ASSERT_EQ(out.got.size(), 5u);
   EXPECT_TRUE(starts_with(out.got[4].reason, "GRASP")) << out.got[4].reason;
   EXPECT_FALSE(out.got[4].p1_used);
-  // A new stripe measurement (another PS): P1 is checked as usual again.
+  // A new stripe measurement 8 mm away (another book's end): P1 is checked as usual again.
   send("SERVO_REQUEST", request(10000, 4, servo_request_t::STRIPE_END));
-  send("SERVO_STATUS", status(11000, 4, servo_request_t::STRIPE_END, servo_status_t::CONVERGED, {0.45, -0.302, 0.10}));
+  send("SERVO_STATUS", status(11000, 4, servo_request_t::STRIPE_END, servo_status_t::CONVERGED, {0.45, -0.297, 0.10}));
   ASSERT_EQ(out.got.size(), 6u);
   EXPECT_TRUE(starts_with(out.got[5].reason, "P1_VALID")) << out.got[5].reason;
 }
@@ -400,11 +400,22 @@ TEST_F(ArbiterNodeTest, ANeighbourCornerFromPsRaisesTheNextBwhStart) {
   ASSERT_EQ(out.got.size(), 4u);
   EXPECT_TRUE(starts_with(out.got[3].reason, "P1_INVALID")) << out.got[3].reason;
   expect_vec(out.got[3].gp_grasp, {0.20, 0.255, 0.01}, "BwH start = PS raised, front depth");
-  // From there BwH centres the tall book's corner (grasp (0.30, 0.253)): grasped.
-  corner_converged(8000, 3, 0, {0.45, -0.303, 0.30});
+  // From the raised start BwH centres another neighbour's corner 40 mm left of PS: no grasp, no second raise.
+  corner_converged(7500, 3, 0, {0.45, -0.265, 0.30});
   ASSERT_EQ(out.got.size(), 5u);
-  EXPECT_TRUE(starts_with(out.got[4].reason, "GRASP")) << out.got[4].reason;
-  expect_vec(out.got[4].gp_grasp, {0.30, 0.253, 0.01}, "GP at the tall book's corner");
+  EXPECT_TRUE(starts_with(out.got[4].reason, "NO_GRASP: P2 is still 40.0 mm left of the stripe end"))
+      << out.got[4].reason;
+  // The stripe end measured again 0.2 mm away is the same book's: the next start is still raised.
+  send("SERVO_REQUEST", request(9000, 4, servo_request_t::STRIPE_END));
+  send("SERVO_STATUS", status(9100, 4, servo_request_t::STRIPE_END, servo_status_t::CONVERGED, {0.45, -0.3052, 0.10}));
+  ASSERT_EQ(out.got.size(), 6u);
+  EXPECT_TRUE(starts_with(out.got[5].reason, "P1_INVALID")) << out.got[5].reason;
+  expect_vec(out.got[5].gp_grasp, {0.20, 0.2552, 0.01}, "BwH start = the re-measured PS raised");
+  // From there BwH centres the tall book's corner (grasp (0.30, 0.253)): grasped.
+  corner_converged(10000, 5, 0, {0.45, -0.303, 0.30});
+  ASSERT_EQ(out.got.size(), 7u);
+  EXPECT_TRUE(starts_with(out.got[6].reason, "GRASP")) << out.got[6].reason;
+  expect_vec(out.got[6].gp_grasp, {0.30, 0.253, 0.01}, "GP at the tall book's corner");
 }
 
 TEST_F(ArbiterNodeTest, NoRegionLeftGivesNoGrasp) {

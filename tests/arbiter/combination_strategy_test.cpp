@@ -408,14 +408,19 @@ TEST(CombinationStrategy, WithoutAValidP1AP2FarLeftOfAMeasuredPsRaisesTheNextBwh
   EXPECT_NEAR(check.bwh_start.z(), 0.42, 1e-12);
   ASSERT_FALSE(check.steps.empty());
   EXPECT_EQ(check.steps.back().rule, "BwH start raised");
-  // From there, the tall book's corner at the stripe end is grasped; the same far-left P2 again goes to the paper's
-  // rules (no second raise).
+  // From there, the tall book's corner at the stripe end is grasped; a far-left P2 again gets no grasp (no second
+  // raise: a failed attempt, far_cart seed 5302 once converged 72 mm left from the raised start).
   in.p2 = V(0.23, 0.098, 0.45);
   const CombinationResult tall = combine(in, tol);
   EXPECT_EQ(tall.outcome, GraspOutcome::kGrasp);
   EXPECT_TRUE(tall.gp.isApprox(V(0.23, 0.098, 0.42), 1e-12)) << tall.gp.transpose();
   in.p2 = V(0.12, 0.075, 0.45);
-  EXPECT_EQ(combine(in, tol).outcome, GraspOutcome::kGrasp);
+  const CombinationResult again = combine(in, tol);
+  EXPECT_EQ(again.outcome, GraspOutcome::kNoGrasp);
+  ASSERT_FALSE(again.steps.empty());
+  EXPECT_NE(again.steps.back().decision.find("still 25.0 mm left of the stripe end from the raised start"),
+            std::string::npos)
+      << again.steps.back().decision;
   // A valid P1 never raises the start.
   CombinationInputs valid = in;
   valid.p1 = V(0.22, 0.099, 0.40);
