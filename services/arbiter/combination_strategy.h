@@ -128,7 +128,8 @@ struct CombinationResult {
 std::optional<double> front_depth_without_p1(const CombinationInputs& in, const CombinationTolerances& tol,
                                              ValidationStep* step);
 
-/// Step 1 only (Section 3.1): is P1 valid against PS, and where BwH starts.
+/// Step 1 only (Section 3.1): is P1 valid against PS, and where BwH starts. Not in the paper: without a valid P1
+/// and with in.bwh_start_raised, the start is raised by tol.raised_bwh_start_x (step "BwH start raised").
 /// Used before servoing; combine() repeats it so its trace is complete.
 CombinationResult validate_p1(const CombinationInputs& in, const CombinationTolerances& tol);
 
