@@ -166,36 +166,31 @@ CombinationResult combine(const CombinationInputs& in, const CombinationToleranc
       return r;
     }
   }
-  // Not in the paper: a measured PS is the right-most book's right edge within a few mm. A P2 far left of it, reached
-  // from a valid P1, is the corner of the book P1 lay on: a taller left neighbour of a thin right-most book. (After the
-  // rule above: a P2 left of and above a P1 on the right book keeps GP = P1.)
-  if (r.p1_valid && in.ps_measured && tol.p2_ps_y > 0) {
+  // Not in the paper: a measured PS is the right-most book's right edge within a few mm, so a P2 far left of it is a
+  // left neighbour's corner. With a valid P1 it is the book P1 lay on, a taller neighbour of a thin right-most book
+  // (P1_LED_ASTRAY: BwH from PS next). Without one, BwH from PS at the stripe's height centred a shorter neighbour's
+  // corner, the tall right-most book's lying above the view (RAISE_BWH_START: BwH from higher next; once raised, no
+  // grasp). After the rule above: a P2 left of and above a P1 on the right book keeps GP = P1.
+  if (in.ps_measured && tol.p2_ps_y > 0 && (r.p1_valid || tol.raised_bwh_start_x > 0)) {
     const double dps = p2.y() - in.ps.y();
     if (dps < -tol.p2_ps_y) {
-      r.steps.push_back(step("P2.y vs measured PS.y", dps, tol.p2_ps_y, false,
-                             "P2 is " + mm(-dps) +
-                                 " left of the stripe end: P1 led BwH to a left neighbour's "
-                                 "corner; the next attempt starts BwH from PS"));
-      r.outcome = GraspOutcome::kP1LedAstray;
-      return r;
-    }
-    r.steps.push_back(step("P2.y vs measured PS.y", dps, tol.p2_ps_y, true, "P2 at the stripe end's book"));
-  }
-  // Not in the paper: the same measured-PS test without a valid P1. BwH started from PS at the stripe's height and
-  // centred a corner far left of it: a shorter left neighbour's, the tall right-most book's corner above the view.
-  if (!r.p1_valid && in.ps_measured && tol.p2_ps_y > 0 && tol.raised_bwh_start_x > 0) {
-    const double dps = p2.y() - in.ps.y();
-    if (dps < -tol.p2_ps_y) {
-      // Once raised, no second raise: a failed attempt (the next one starts from the raised start again).
-      r.outcome = in.bwh_start_raised ? GraspOutcome::kNoGrasp : GraspOutcome::kRaiseBwhStart;
-      r.steps.push_back(step("P2.y vs measured PS.y", dps, tol.p2_ps_y, false,
-                             in.bwh_start_raised
-                                 ? "P2 is still " + mm(-dps) +
-                                       " left of the stripe end from the raised start: a neighbour's corner, no grasp"
-                                 : "P2 is " + mm(-dps) +
-                                       " left of the stripe end without a valid P1: a shorter left neighbour's "
-                                       "corner; the next attempt starts BwH " +
-                                       mm(tol.raised_bwh_start_x) + " higher"));
+      std::string why;
+      if (r.p1_valid) {
+        r.outcome = GraspOutcome::kP1LedAstray;
+        why = "P2 is " + mm(-dps) +
+              " left of the stripe end: P1 led BwH to a left neighbour's corner; the next attempt starts BwH from PS";
+      } else if (in.bwh_start_raised) {
+        r.outcome = GraspOutcome::kNoGrasp;
+        why =
+            "P2 is still " + mm(-dps) + " left of the stripe end from the raised start: a neighbour's corner, no grasp";
+      } else {
+        r.outcome = GraspOutcome::kRaiseBwhStart;
+        why = "P2 is " + mm(-dps) +
+              " left of the stripe end without a valid P1: a shorter left neighbour's corner; the next attempt starts "
+              "BwH " +
+              mm(tol.raised_bwh_start_x) + " higher";
+      }
+      r.steps.push_back(step("P2.y vs measured PS.y", dps, tol.p2_ps_y, false, why));
       return r;
     }
     r.steps.push_back(step("P2.y vs measured PS.y", dps, tol.p2_ps_y, true, "P2 at the stripe end's book"));

@@ -72,7 +72,7 @@ class FakeLibrary {
   std::map<std::string, int> plan_failures;  ///< state name -> failures of the next plans there
   int next_region_once = 0;                  ///< BwH rank 0 answers NEXT_REGION this many times
   int no_grasp_once = 0;                     ///< BwH answers NO_GRASP this many times
-  int p1_led_astray_once = 0;                ///< BwH answers `reroute_outcome` this many times
+  int reroute_once = 0;                      ///< BwH answers `reroute_outcome` this many times
   std::string reroute_outcome = "P1_LED_ASTRAY";  ///< or RAISE_BWH_START: both re-route BwH within the attempt
   bool p1_absent_after_reroute = false;      ///< the P1 check after a re-route has no P1 (BwS missed the book there)
   bool rerouted = false;                     ///< a re-route was answered and its P1 check not yet made
@@ -395,8 +395,8 @@ class FakeLibrary {
               --next_region_once;
               d.outcome = "NEXT_REGION";
               d.next_rank = 1;
-            } else if (p1_led_astray_once > 0) {
-              --p1_led_astray_once;
+            } else if (reroute_once > 0) {
+              --reroute_once;
               d.outcome = reroute_outcome;
               rerouted = true;
             } else if (no_grasp_once > 0 || upper.empty()) {

@@ -539,7 +539,7 @@ TEST(LibraryCycle, AReRoutedCornerSearchParksAndChecksP1AgainWithinTheSameAttemp
   for (const std::string outcome : {"P1_LED_ASTRAY", "RAISE_BWH_START"}) {
     SCOPED_TRACE(outcome);
     FakeLibrary w(three_books());
-    w.p1_led_astray_once = 1;
+    w.reroute_once = 1;
     w.reroute_outcome = outcome;
     LibraryCycle cycle(settings(), std::nullopt);
     w.run(cycle, [&] { return done_or_aborted(cycle); });
@@ -574,7 +574,7 @@ TEST(LibraryCycle, AP1CheckWithoutP1AfterAReRouteStartsBwhWithoutTheStripeServo)
   LibraryCycle plain_cycle(settings(), std::nullopt);
   plain.run(plain_cycle, [&] { return done_or_aborted(plain_cycle); });
   FakeLibrary w(three_books());
-  w.p1_led_astray_once = 1;
+  w.reroute_once = 1;
   w.reroute_outcome = "RAISE_BWH_START";
   w.p1_absent_after_reroute = true;
   LibraryCycle cycle(settings(), std::nullopt);
