@@ -69,6 +69,7 @@ CycleGeometry CycleGeometry::from_config(const Config& c) {
   g.holder_place_guard = c.get_double("holder.place_guard_m", 0.0, 0.1);
   g.holder_retreat = c.get_double("holder.retreat_m", 0.02, 0.6);
   g.holder_regrasp_lower = c.get_double("holder.regrasp_lower_m", 0.0, 0.03);
+  g.holder_regrasp_min_height = c.get_double("holder.regrasp_min_height_m", 0.0, 0.5);
   g.lower_drop = c.get_double("lower_shelf.drop_m", 0.1, 1.5);
   g.lower_front_z = c.get_double("lower_shelf.front_z_m", -0.2, 0.5);
   g.lower_first_right_y = c.get_double("lower_shelf.first_right_y_m", -3, 3);
@@ -208,7 +209,7 @@ double tcp_height_on_book(const Eigen::Vector3d& gp_grasp, const CycleGeometry& 
 }
 
 double holder_regrasp_height(double tcp_height, const CycleGeometry& g) {
-  return tcp_height - g.holder_regrasp_lower;
+  return std::max(tcp_height - g.holder_regrasp_lower, std::min(tcp_height, g.holder_regrasp_min_height));
 }
 
 double height_held_from_holder(double tcp_height, const CycleGeometry& g) {

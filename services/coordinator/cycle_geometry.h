@@ -83,7 +83,10 @@ struct CycleGeometry {
   double holder_place_guard = 0.0;
   double lower_place_guard = 0.0;   ///< the same for the place on the lower shelf
   double holder_retreat = 0.10;     ///< after release, out along the gripper -z
-  double holder_regrasp_lower = 0.0;  ///< the grasp from the holder puts the TCP this much lower on the book
+  double holder_regrasp_lower = 0.0;  ///< the grasp from the holder puts the TCP this much lower on the book ...
+  /// ... but not lower than this above the book's bottom (nor higher than the release): a short book's lower-shelf
+  /// place needs the TCP that high (arm_2's reach down to the lower shelf). 0 = always holder_regrasp_lower.
+  double holder_regrasp_min_height = 0.0;
   // lower shelf
   double lower_drop = 0.35;         ///< lower shelf surface below the upper one
   double lower_front_z = 0.01;      ///< fore-edges' plane on the lower shelf, grasp Z
@@ -167,7 +170,8 @@ bool holds_more_than_the_book(double plate_distance, const ForeEdges& edges, con
 /// Book height above its support at the TCP: GP.x (top above the upper shelf) plus the X offset.
 double tcp_height_on_book(const Eigen::Vector3d& gp_grasp, const CycleGeometry& g);
 /// TCP height above the book's bottom for the grasp from the holder: `tcp_height` (the grasp from the shelf)
-/// less `holder_regrasp_lower`; the holder poses take it as their `tcp_height`.
+/// less `holder_regrasp_lower`, but at least `holder_regrasp_min_height` (and at most `tcp_height`); the holder
+/// poses take it as their `tcp_height`.
 double holder_regrasp_height(double tcp_height, const CycleGeometry& g);
 /// TCP height above the book's bottom once it is in the plates after the grasp from the holder: the book
 /// stood on the ledge, `place_clearance` below where it was released (what the lower-shelf poses take).

@@ -152,6 +152,25 @@ TEST(CycleGeometry, TheGraspFromTheHolderIsLowerAndTheBookHangsLessBelowTheTcp) 
   EXPECT_NEAR(height_held_from_holder(0.25, g), 0.24, 1e-12);  // the book dropped 5 mm onto the ledge
 }
 
+TEST(CycleGeometry, AShortBooksGraspFromTheHolderStaysHighEnoughForTheLowerShelf) {
+  CycleGeometry g = geometry();
+  g.holder_regrasp_min_height = 0.15;
+  // A tall book: the full 15 mm lower.
+  EXPECT_NEAR(holder_regrasp_height(0.25, g), 0.235, 1e-12);
+  // 0.16 m: lowered only to 0.15.
+  EXPECT_NEAR(holder_regrasp_height(0.16, g), 0.15, 1e-12);
+  EXPECT_NEAR(height_held_from_holder(0.16, g), 0.155, 1e-12);
+  // A 0.13 m release (a 0.143 m book): not lowered at all, and never above where it was released.
+  EXPECT_NEAR(holder_regrasp_height(0.13, g), 0.13, 1e-12);
+  // The place on the lower shelf is then 15 mm higher than with the full lowering.
+  const Eigen::Isometry3d f = Eigen::Isometry3d::Identity();
+  CycleGeometry full = g;
+  full.holder_regrasp_min_height = 0.0;
+  EXPECT_NEAR(lower_place_pose(f, 0.1, 0.02, height_held_from_holder(0.13, g), g).translation().x() -
+                  lower_place_pose(f, 0.1, 0.02, height_held_from_holder(0.13, full), full).translation().x(),
+              0.015, 1e-12);
+}
+
 TEST(CycleGeometry, TheLowerPrePlaceCentresTheHeldBookBetweenTheShelves) {
   const CycleGeometry g = geometry();
   const Eigen::Isometry3d f = Eigen::Isometry3d::Identity();  // the grasp frame is base here
