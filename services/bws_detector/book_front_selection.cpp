@@ -31,6 +31,7 @@ SelectionParams SelectionParams::from_config(const Config& c) {
   p.top_growth_disparity_px = c.get_double("top_growth_disparity_px", 0.0, 100.0);
   p.top_growth_max_gap_px = c.get_int("top_growth_max_gap_px", 0, 1000);
   p.top_growth_columns = c.get_int("top_growth_columns", 1, 1000);
+  p.top_growth_climbed_only = c.get<bool>("top_growth_climbed_only");
   p.edge_fattening_px = c.get_double("edge_fattening_px", 0.0, 100.0);
   p.pi_rule =
       c.get_choice("pi_rule", {"paper", "right_column_top"}) == "paper" ? PiRule::kPaper : PiRule::kRightColumnTop;
@@ -97,11 +98,11 @@ cv::Point right_column_top(const cv::Mat& labels, int label) {
 
 cv::Point raise_to_plane_top(const cv::Mat& labels, int label, cv::Point pi, const cv::Mat& points_camera,
                              const Eigen::Vector3d& normal, double offset, const StereoGeometry& g, double tolerance_px,
-                             int max_px, int max_gap_px, int columns) {
+                             int max_px, int max_gap_px, int columns, bool climbed_only) {
   if (labels.type() != CV_32S || points_camera.type() != CV_32FC3 || points_camera.size() != labels.size())
     throw std::invalid_argument("raise_to_plane_top: CV_32S labels and CV_32FC3 points of one size expected");
   const double fb = g.fx * g.baseline_m;
-  std::vector<int> tops;
+  std::vector<int> tops, climbed;
   for (int x = pi.x; x > pi.x - columns && x >= 0; --x) {
     int top = -1;
     for (int y = 0; y < labels.rows && top < 0; ++y)
@@ -126,7 +127,9 @@ cv::Point raise_to_plane_top(const cv::Mat& labels, int label, cv::Point pi, con
       gap = 0;
     }
     tops.push_back(top);
+    if (start - top > max_gap_px) climbed.push_back(top);
   }
+  if (climbed_only && !climbed.empty()) tops = climbed;
   if (tops.empty()) return pi;
   std::nth_element(tops.begin(), tops.begin() + long(tops.size() / 2), tops.end());
   return {pi.x, std::min(pi.y, tops[tops.size() / 2])};
@@ -515,7 +518,8 @@ BookFrontResult select_book_front(const SegmentationResult& seg, const cv::Mat& 
   if (p.top_growth_px > 0)
     out.pi =
         raise_to_plane_top(out.split ? band_mask : inside_mask, best, out.pi, points_camera, r.normal, offset, g,
-                           p.top_growth_disparity_px, p.top_growth_px, p.top_growth_max_gap_px, p.top_growth_columns);
+                           p.top_growth_disparity_px, p.top_growth_px, p.top_growth_max_gap_px, p.top_growth_columns,
+                           p.top_growth_climbed_only);
   // P1's ray: through PI moved edge_fattening_px left and down (StereoBM's border of a near surface
   // in front of a farther one lies that far out; the right-most front's right and top edges are such).
   const Eigen::Vector3d ray((out.pi.x - p.edge_fattening_px - g.cx) / g.fx,

@@ -90,6 +90,10 @@ struct SelectionParams {
   int top_growth_max_gap_px = 3;
   /// PI's new row is the median of the grown tops of this many columns ending at PI's.
   int top_growth_columns = 3;
+  /// ... of those that climbed more than top_growth_max_gap_px rows, when any did: a thin front's page face
+  /// has no stereo depth inside its border columns, which then stay at the region's top and outvote the
+  /// border column that follows the front up (docs/BWS.md "The top over the columns that climbed").
+  bool top_growth_climbed_only = false;
   /// P1's viewing ray passes this many pixels left of and below PI: block matching extends a near
   /// surface into a farther background by up to half a block ((block_size - 1) / 2), and the
   /// right-most front's right and top edges border a farther background. 0 = the ray through PI.
@@ -172,10 +176,12 @@ cv::Point right_column_top(const cv::Mat& labels, int label);
 /// of the disparity of the plane { p : normal . p = offset } (left camera frame, metres) on that
 /// pixel's ray, up to `max_gap_px` pixels in a row without depth or off the plane bridged (StereoBM
 /// leaves holes and outliers on a narrow front), at most `max_px` rows; the result keeps pi.x and
-/// takes the median of the columns' tops (never lower than pi.y).
+/// takes the median of the columns' tops (never lower than pi.y). With `climbed_only`, the median of the
+/// tops of the columns that climbed more than `max_gap_px` rows, when any did.
 cv::Point raise_to_plane_top(const cv::Mat& labels, int label, cv::Point pi, const cv::Mat& points_camera,
                              const Eigen::Vector3d& normal, double offset, const StereoGeometry& geometry,
-                             double tolerance_px, int max_px, int max_gap_px, int columns);
+                             double tolerance_px, int max_px, int max_gap_px, int columns,
+                             bool climbed_only = false);
 
 /// Runs the book-front tests on every region of `segmentation` (planes in the
 /// left camera frame, metres), picks the right-most candidate (smallest base y

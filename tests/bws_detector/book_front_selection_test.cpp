@@ -92,6 +92,24 @@ TEST(RaiseToPlaneTop, ClimbsTheFrontsRowsUpToItsEdge) {
   EXPECT_EQ(raise_to_plane_top(f.labels, 1, pi, f.points, f.normal, f.offset, f.g, 0.5, 30, 1, 3), cv::Point(15, 5));
 }
 
+TEST(RaiseToPlaneTop, OverTheColumnsThatClimbedAThinFrontsBorderColumnLeadsUp) {
+  FrontAboveItsRegion f;
+  // A thin front's page face: columns 13 and 14 have no depth above row 10 (no texture), only the border
+  // column 15 follows the front up to row 5.
+  for (int y = 0; y < 11; ++y)
+    for (const int x : {13, 14}) f.points.at<cv::Vec3f>(y, x) = cv::Vec3f(NAN, NAN, NAN);
+  const cv::Point pi(15, 12);
+  // The median of all three columns (5, 11, 11) stays near the region's top; over those that climbed
+  // more than max_gap_px rows, PI goes up to the front's top.
+  EXPECT_EQ(raise_to_plane_top(f.labels, 1, pi, f.points, f.normal, f.offset, f.g, 0.5, 30, 1, 3), cv::Point(15, 11));
+  EXPECT_EQ(raise_to_plane_top(f.labels, 1, pi, f.points, f.normal, f.offset, f.g, 0.5, 30, 1, 3, true),
+            cv::Point(15, 5));
+  // When no column climbed, all of them vote as before.
+  for (int y = 0; y < 11; ++y) f.points.at<cv::Vec3f>(y, 15) = cv::Vec3f(NAN, NAN, NAN);
+  EXPECT_EQ(raise_to_plane_top(f.labels, 1, pi, f.points, f.normal, f.offset, f.g, 0.5, 30, 1, 3, true),
+            cv::Point(15, 11));
+}
+
 TEST(RaiseToPlaneTop, BridgesAStereoOutlier) {
   FrontAboveItsRegion f;
   f.points.at<cv::Vec3f>(9, 15) *= 1.5f;  // 3 m instead of 2 m: 8.3 px off the plane

@@ -109,6 +109,11 @@ TEST(BwsConfig, BadSelectionValuesNameTheKey) {
   EXPECT_NE(err(replaced(ok, "top_growth_columns: 3", "top_growth_columns: 0")).find("top_growth_columns"),
             std::string::npos);
   EXPECT_NE(err(replaced(ok, "  top_growth_columns: 3", "  # gone")).find("top_growth_columns"), std::string::npos);
+  EXPECT_NE(err(replaced(ok, "top_growth_climbed_only: true", "top_growth_climbed_only: maybe"))
+                .find("top_growth_climbed_only"),
+            std::string::npos);
+  EXPECT_NE(err(replaced(ok, "  top_growth_climbed_only: true", "  # gone")).find("top_growth_climbed_only"),
+            std::string::npos);
 }
 
 TEST(BwsConfig, BadPclSpaceValuesNameTheKey) {
