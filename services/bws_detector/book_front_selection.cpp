@@ -516,10 +516,9 @@ BookFrontResult select_book_front(const SegmentationResult& seg, const cv::Mat& 
     out.pi = corner_of(inside_mask);
   }
   if (p.top_growth_px > 0)
-    out.pi =
-        raise_to_plane_top(out.split ? band_mask : inside_mask, best, out.pi, points_camera, r.normal, offset, g,
-                           p.top_growth_disparity_px, p.top_growth_px, p.top_growth_max_gap_px, p.top_growth_columns,
-                           p.top_growth_climbed_only);
+    out.pi = raise_to_plane_top(out.split ? band_mask : inside_mask, best, out.pi, points_camera, r.normal, offset, g,
+                                p.top_growth_disparity_px, p.top_growth_px, p.top_growth_max_gap_px,
+                                p.top_growth_columns, p.top_growth_climbed_only);
   // P1's ray: through PI moved edge_fattening_px left and down (StereoBM's border of a near surface
   // in front of a farther one lies that far out; the right-most front's right and top edges are such).
   const Eigen::Vector3d ray((out.pi.x - p.edge_fattening_px - g.cx) / g.fx,

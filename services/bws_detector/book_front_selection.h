@@ -180,8 +180,7 @@ cv::Point right_column_top(const cv::Mat& labels, int label);
 /// tops of the columns that climbed more than `max_gap_px` rows, when any did.
 cv::Point raise_to_plane_top(const cv::Mat& labels, int label, cv::Point pi, const cv::Mat& points_camera,
                              const Eigen::Vector3d& normal, double offset, const StereoGeometry& geometry,
-                             double tolerance_px, int max_px, int max_gap_px, int columns,
-                             bool climbed_only = false);
+                             double tolerance_px, int max_px, int max_gap_px, int columns, bool climbed_only = false);
 
 /// Runs the book-front tests on every region of `segmentation` (planes in the
 /// left camera frame, metres), picks the right-most candidate (smallest base y
