@@ -74,7 +74,10 @@ arm_state_t arm(int64_t utime, int8_t state, int64_t active) {
 class CoordinatorNodeTest : public testing::Test {
  protected:
   void SetUp() override {
-    path = testing::TempDir() + "/coordinator_node_test_progress.yaml";
+    // One file per test: ctest runs this file's tests as parallel processes, and a shared file let one test's
+    // progress overwrite another's corrupt one (CI, stop 30).
+    path = testing::TempDir() + "/coordinator_node_test_progress_" +
+           testing::UnitTest::GetInstance()->current_test_info()->name() + ".yaml";
     std::remove(path.c_str());
   }
   void TearDown() override { std::remove(path.c_str()); }

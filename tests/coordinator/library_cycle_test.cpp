@@ -348,11 +348,11 @@ TEST(LibraryCycle, AMissedGraspFromTheHolderBacksOutStraightBeforePlanning) {
 
 TEST(LibraryCycle, AForeEdgeWidthFromTheCornerServoOpensThePlatesOnlySoFar) {
   // coordinator.yaml: open_width_m 0.06, offset_y_m -0.015 (right plate 15 mm right of GP); width_left_clearance_m is
-  // shipped off (0), set to 8 mm here. left_plate_on_neighbour (plate 10 mm, clearance 3 mm): the left plate's middle
+  // shipped at 5 mm, set to 8 mm and to 0 (the full opening) here. left_plate_on_neighbour (plate 10 mm, clearance 3 mm): the left plate's middle
   // on the next book's middle; three_books() stand 2 mm apart, so books 0 and 1 get it, book 2 (none left of it)
   // the width rule.
   const CycleSettings shipped = settings();
-  ASSERT_EQ(shipped.geometry.width_left_clearance, 0.0);
+  ASSERT_NEAR(shipped.geometry.width_left_clearance, 0.005, 1e-12);
   ASSERT_NEAR(shipped.gripper_open_width, 0.06, 1e-12);
   ASSERT_NEAR(shipped.geometry.plate_thickness, 0.010, 1e-12);
   struct Case {
@@ -406,6 +406,9 @@ TEST(LibraryCycle, PlatesClosedOnMoreThanTheBookTryAgainOpenedToTheBookOnly) {
   // coordinator.yaml: more_than_the_book_m 2.5 mm, retry_left_clearance_m 5 mm. three_books(): book 0 25 mm wide, book
   // 1 20 mm, 2 mm apart: a close on both stops at 47 mm.
   CycleSettings cs = settings();
+  // The full opening for a first attempt (width_left_clearance_m 0; shipped at 5 mm), where the neighbour can stand
+  // between the plates.
+  cs.geometry.width_left_clearance = 0.0;
   ASSERT_NEAR(cs.geometry.more_than_the_book, 0.0025, 1e-12);
   ASSERT_NEAR(cs.geometry.retry_left_clearance, 0.005, 1e-12);
   FakeLibrary w(three_books());
