@@ -179,12 +179,16 @@ double palm_over_right_panel(const PlateOpening& o, double gp_y, const CycleGeom
   return gp_y + o.offset_y + g.palm_half_width + g.right_panel_clearance - g.shelf_right_y;
 }
 
-PlateOpening plate_opening_clear_of_right_panel(const PlateOpening& o, double gp_y, const CycleGeometry& g) {
+PlateOpening plate_opening_clear_of_right_panel(const PlateOpening& o, double gp_y, double open_width,
+                                                const CycleGeometry& g) {
   const double over = palm_over_right_panel(o, gp_y, g);
   if (over <= 0) return o;
-  // The right plate's inner face (offset_y + width / 2 right of GP) stays right_plate_min_clearance right of GP.
-  const double lowest = std::min(o.offset_y, g.right_plate_min_clearance - 0.5 * o.width);
-  return {o.width, std::max(o.offset_y - over, lowest)};
+  // The right plate's inner face (offset_y + width / 2 right of GP) stays right_plate_min_clearance right of GP; a
+  // narrowed opening widens on the left (up to open_width) where that alone would stop the palm short of clear.
+  const double wanted = o.offset_y - over;
+  const double width = std::max(o.width, std::min(open_width, 2.0 * (g.right_plate_min_clearance - wanted)));
+  const double lowest = std::min(o.offset_y, g.right_plate_min_clearance - 0.5 * width);
+  return {width, std::max(wanted, lowest)};
 }
 
 bool holds_more_than_the_book(double plate_distance, const ForeEdges& edges, const CycleGeometry& g) {

@@ -158,9 +158,12 @@ PlateOpening plate_opening_after_more_than_the_book(const ForeEdges& edges, doub
 /// and more_than_the_book > 0 only).
 /// `o` moved left, plates and palm together, so that for a GP at grasp Y `gp_y` the palm's right side stays
 /// right_panel_clearance left of the right side panel (shelf_right_y). It moves no further than keeps the right
-/// plate's inner face right_plate_min_clearance right of GP (the book's right edge); the palm may then still meet
-/// the panel. `o` unchanged with palm_half_width 0, a GP far enough from the panel, or a GP not finite.
-PlateOpening plate_opening_clear_of_right_panel(const PlateOpening& o, double gp_y, const CycleGeometry& g);
+/// plate's inner face right_plate_min_clearance right of GP (the book's right edge); an opening narrowed to the book
+/// (plate_opening) then opens further on the left, up to `open_width`, so that the palm can go as far left as with
+/// the full opening; beyond that the palm may still meet the panel. `o` unchanged with palm_half_width 0, a GP far
+/// enough from the panel, or a GP not finite.
+PlateOpening plate_opening_clear_of_right_panel(const PlateOpening& o, double gp_y, double open_width,
+                                                const CycleGeometry& g);
 
 /// How far (m) the palm reaches past right_panel_clearance from the right side panel for a GP at grasp Y `gp_y`
 /// with the opening `o` (> 0: it meets the panel or comes too near; <= 0: clear). 0 with palm_half_width 0.

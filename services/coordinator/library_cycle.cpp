@@ -367,7 +367,8 @@ PlateOpening LibraryCycle::book_opening() const {
 }
 
 PlateOpening LibraryCycle::grasp_opening() const {
-  return plate_opening_clear_of_right_panel(book_opening(), progress_.gp_grasp.y(), s_.geometry);
+  return plate_opening_clear_of_right_panel(book_opening(), progress_.gp_grasp.y(), s_.gripper_open_width,
+                                            s_.geometry);
 }
 
 CycleGeometry LibraryCycle::grasp_geometry() const {

@@ -88,27 +88,42 @@ TEST(CycleGeometry, ABookNearTheRightSidePanelMovesPlatesAndPalmLeft) {
   const PlateOpening full{0.06, -0.015};
   // Far from the panel: the palm's right side at 300 - 15 + 57 = 342 mm, 58 mm from it. Unchanged.
   EXPECT_LE(palm_over_right_panel(full, 0.30, g), 0.0);
-  EXPECT_EQ(plate_opening_clear_of_right_panel(full, 0.30, g).offset_y, -0.015);
+  EXPECT_EQ(plate_opening_clear_of_right_panel(full, 0.30, 0.06, g).offset_y, -0.015);
   // Far_cart seed 5022's GP, 359.6 mm: the palm's right side at 401.6 mm, 1.6 mm into the panel (+ 5 mm clearance).
   EXPECT_NEAR(palm_over_right_panel(full, 0.3596, g), 0.0066, 1e-12);
-  const PlateOpening moved = plate_opening_clear_of_right_panel(full, 0.3596, g);
+  const PlateOpening moved = plate_opening_clear_of_right_panel(full, 0.3596, 0.06, g);
   EXPECT_EQ(moved.width, 0.06);
   EXPECT_NEAR(moved.offset_y, -0.0216, 1e-12);
   EXPECT_NEAR(0.3596 + moved.offset_y + 0.057, 0.395, 1e-12);      // the palm 5 mm from the panel
   EXPECT_NEAR(moved.offset_y + 0.5 * moved.width, 0.0084, 1e-12);  // the right plate 8.4 mm right of the book
   EXPECT_LE(palm_over_right_panel(moved, 0.3596, g), 1e-12);
   // Nearer still (375 mm): the right plate stops 3 mm right of the book; the palm still comes 10 mm too near.
-  const PlateOpening limited = plate_opening_clear_of_right_panel(full, 0.375, g);
+  const PlateOpening limited = plate_opening_clear_of_right_panel(full, 0.375, 0.06, g);
   EXPECT_NEAR(limited.offset_y + 0.5 * limited.width, 0.003, 1e-12);
   EXPECT_NEAR(palm_over_right_panel(limited, 0.375, g), 0.010, 1e-12);
-  // A narrowed opening (45 mm, right plate 15 mm right of GP) moves the same way, down to its own 3 mm.
-  const PlateOpening narrow = plate_opening_clear_of_right_panel({0.045, -0.0075}, 0.3596, g);
+  // A narrowed opening (40 mm, right plate 15 mm right of GP, as for a 20 mm book + 5 mm) at seed 5022's GP: moved
+  // alone, its right plate would stop 3 mm right of the book with the palm 4.6 mm into the 5 mm clearance (5022
+  // ABORTED in INSERT with the narrow opening, stop 30). It opens further on the left instead, to where the full
+  // opening's move puts the palm: 5 mm from the panel, the right plate 3 mm right of the book.
+  const PlateOpening narrowed{0.040, -0.005};
+  const PlateOpening narrow = plate_opening_clear_of_right_panel(narrowed, 0.3596, 0.06, g);
+  EXPECT_NEAR(narrow.offset_y, -0.0216, 1e-12);
   EXPECT_NEAR(narrow.offset_y + 0.5 * narrow.width, 0.003, 1e-12);
+  EXPECT_NEAR(narrow.width, 0.0492, 1e-12);
+  EXPECT_LE(palm_over_right_panel(narrow, 0.3596, g), 1e-12);
+  // Never wider than the gripper opens: at 375 mm it is the full opening's limited move.
+  const PlateOpening narrow_limited = plate_opening_clear_of_right_panel(narrowed, 0.375, 0.06, g);
+  EXPECT_NEAR(narrow_limited.width, 0.06, 1e-12);
+  EXPECT_NEAR(narrow_limited.offset_y, limited.offset_y, 1e-12);
+  // A narrowed opening that its own move clears stays as narrow: 10 mm nearer the middle of the shelf.
+  const PlateOpening near = plate_opening_clear_of_right_panel(narrowed, 0.3496, 0.06, g);
+  EXPECT_NEAR(near.width, 0.040, 1e-12);
+  EXPECT_LE(palm_over_right_panel(near, 0.3496, g), 1e-12);
   // Off (palm width 0), or no GP known: unchanged.
   for (const double gp_y : {0.3596, double(NAN)}) {
     CycleGeometry off = g;
     if (std::isfinite(gp_y)) off.palm_half_width = 0.0;
-    EXPECT_EQ(plate_opening_clear_of_right_panel(full, gp_y, off).offset_y, -0.015) << gp_y;
+    EXPECT_EQ(plate_opening_clear_of_right_panel(full, gp_y, 0.06, off).offset_y, -0.015) << gp_y;
     EXPECT_EQ(palm_over_right_panel(full, gp_y, off), 0.0) << gp_y;
   }
 }
