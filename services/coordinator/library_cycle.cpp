@@ -762,7 +762,7 @@ void LibraryCycle::enter(CycleState s) {
       const PlateOpening opening = grasp_opening();
       const double shift = book_opening().offset_y - opening.offset_y;
       const double over = palm_over_right_panel(opening, progress_.gp_grasp.y(), s_.geometry);
-      if (over > 0)
+      if (over > 1e-4)  // not a rounding error's 1e-17 of a move that just clears
         message_ += "; the palm comes " + mm(over) + " nearer the right side panel than grasp.right_panel_clearance_m" +
                     " allows, with the plates " + mm(shift) + " further left: INSERT may meet the panel";
       else if (shift > 0)
