@@ -523,7 +523,9 @@ TEST(LibraryCycle, BadDepthKeysNameTheKey) {
         {"limit_stop_place_m", "limit_stop_place_m: 0.02", "limit_stop_place_m: 0.2"},
         // The plate-distance check: 0 would leave the retry as wide as the grasp.
         {"grasp.retry_left_clearance_m", "retry_left_clearance_m: 0.005", "retry_left_clearance_m: 0.0"},
-        {"grasp.more_than_the_book_m", "more_than_the_book_m: 0.0025", "more_than_the_book_m: 0.2"}}) {
+        {"grasp.more_than_the_book_m", "more_than_the_book_m: 0.0025", "more_than_the_book_m: 0.2"},
+        {"grasp.width_left_clearance_m", "width_left_clearance_m: 0.005", "width_left_clearance_m: 0.2"},
+        {"holder.regrasp_min_height_m", "regrasp_min_height_m: 0.15", "regrasp_min_height_m: -0.1"}}) {
     std::string text = shipped;
     const auto pos = text.find(line);
     ASSERT_NE(pos, std::string::npos) << line;
