@@ -82,6 +82,7 @@ ArbiterSettings ArbiterSettings::from_config(const Config& root) {
   s.tolerances.hand_corner_max_y_from_p2 = root.get_double("hand_corner.max_y_from_p2_m", 0.0, 0.1);
   s.tolerances.p2_ps_y = root.get_double("tolerances.p2_measured_ps_y_m", 0.0, 0.2);
   s.tolerances.raised_bwh_start_x = root.get_double("tolerances.raised_bwh_start_m", 0.0, 0.3);
+  s.tolerances.invalid_p1_over_p2 = root.get<bool>("tolerances.invalid_p1_over_p2");
   s.use_stereo_front = root.get<bool>("stereo_front.enabled");
   const std::vector<double> band = root.get_vector("stereo_front.probe_left_of_ps_m", 2);
   if (!(band[0] >= 0 && band[0] < band[1] && band[1] <= 0.1))

@@ -195,6 +195,28 @@ CombinationResult combine(const CombinationInputs& in, const CombinationToleranc
     }
     r.steps.push_back(step("P2.y vs measured PS.y", dps, tol.p2_ps_y, true, "P2 at the stripe end's book"));
   }
+  // Not in the paper: an invalid P1 left of PS with P2 left of and below it: P1's (taller) book stands between P2's
+  // and PS, so P2 is not the right-most book's corner (deployed demo, seed 1's fifth book: P1 on the 0.29 m right-most
+  // book leaning left, 13 mm left of GP.y - BW; BwH from PS centred the 0.17 m neighbour's corner 30 mm left of P1).
+  // With a measured PS the rule above has answered already (P2 would lie > y + p1_ps_y left of PS).
+  if (!r.p1_valid && tol.invalid_p1_over_p2 && tol.raised_bwh_start_x > 0 && in.p1 && in.p1->allFinite() &&
+      in.p1->y() - in.ps.y() < -tol.p1_ps_y) {
+    const double dy1 = p2.y() - in.p1->y();
+    const double dx1 = p2.x() - in.p1->x();
+    if (dy1 <= -tol.y && dx1 <= -tol.x) {
+      std::string why = "P2 is " + mm(-dy1) + " left of and " + mm(-dx1) + " below the invalid P1, which lies " +
+                        mm(in.ps.y() - in.p1->y()) + " left of PS: P1's book stands between, P2 is a neighbour's corner";
+      if (in.bwh_start_raised) {
+        r.outcome = GraspOutcome::kNoGrasp;
+        why += " (from the raised start too): no grasp";
+      } else {
+        r.outcome = GraspOutcome::kRaiseBwhStart;
+        why += "; the next attempt starts BwH " + mm(tol.raised_bwh_start_x) + " higher";
+      }
+      r.steps.push_back(step("P2 vs invalid P1 (left and below)", dy1, tol.y, false, why));
+      return r;
+    }
+  }
 
   if (std::abs(dy) < tol.y) {
     r.steps.push_back(step("P2.y vs " + ref_name + ".y", dy, tol.y, true, "P2.y valid: within the Y tolerance"));

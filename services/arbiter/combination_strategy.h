@@ -48,6 +48,12 @@ struct CombinationTolerances {
   /// Once raised, such a P2 again gets no grasp (kNoGrasp: a failed attempt; the next one starts raised as well).
   /// 0 = off (the paper accepts such a P2). Needs p2_ps_y > 0.
   double raised_bwh_start_x = 0.0;
+  /// Not in the paper: without a valid P1, a P2 more than `y` left of and more than `x` below a P1 that failed the PS
+  /// check on its left is a shorter left neighbour's corner: P1's book stands between it and PS. The right-most book
+  /// is tall, leans left (its top corner fails the PS check measured at the stripe's height) and its corner lies
+  /// above the hand camera's view from PS. For any PS, measured or the estimate GP.y - BW (the p2_ps_y rule covers
+  /// only a measured one). kRaiseBwhStart as for p2_ps_y, kNoGrasp once raised. Needs raised_bwh_start_x > 0.
+  bool invalid_p1_over_p2 = false;
 };
 
 /// One decision of the strategy, with the numbers it was made on.

@@ -418,6 +418,39 @@ TEST_F(ArbiterNodeTest, ANeighbourCornerFromPsRaisesTheNextBwhStart) {
   expect_vec(out.got[6].gp_grasp, {0.30, 0.253, 0.01}, "GP at the tall book's corner");
 }
 
+// After a grasp, PS is the estimate GP.y - BW. The next right-most book is tall and leans left: its P1 fails the PS
+// check on the left; BwH from PS centres a shorter neighbour's corner left of and below P1. No grasp; the next P1
+// check starts BwH higher (tolerances.invalid_p1_over_p2, raised_bwh_start_m), from where the tall book is grasped.
+TEST_F(ArbiterNodeTest, ANeighbourCornerUnderAnInvalidP1RaisesTheNextBwhStartAfterAGrasp) {
+  grasp_decided();
+  for (int64_t t = 100000; t <= 400000; t += 100000) send("ARM_STATE", arm(t, 0.031, true));
+  ASSERT_EQ(out.got.size(), 4u);
+  ASSERT_TRUE(starts_with(out.got[3].reason, "BOOK_WIDTH: BW = 31.0 mm")) << out.got[3].reason;
+  expect_vec(out.got[3].ps_grasp, {0.10, 0.229, -0.15}, "next PS = GP.y - BW");
+  // P1 base (0.61, -0.266, 0.30) -> grasp (0.30, 0.216, 0.01): 13 mm left of PS, invalid.
+  send("BOOK_CORNER_STEREO", corner(1100000, "god", true, {0.61, -0.266, 0.30}));
+  ASSERT_EQ(out.got.size(), 5u);
+  EXPECT_TRUE(starts_with(out.got[4].reason, "P1_INVALID")) << out.got[4].reason;
+  // P2 grasp (0.17, 0.186): 30 mm left of and 130 mm below P1.
+  corner_converged(1200000, 3, 0, {0.45, -0.236, 0.17});
+  ASSERT_EQ(out.got.size(), 6u);
+  EXPECT_TRUE(starts_with(out.got[5].reason, "RAISE_BWH_START: P2 is 30.0 mm left of and 130.0 mm below the invalid P1"))
+      << out.got[5].reason;
+  EXPECT_FALSE(out.got[5].valid);
+  // The next P1 check: BwH starts from PS 100 mm higher.
+  send("BOOK_CORNER_STEREO", corner(1300000, "god", true, {0.61, -0.266, 0.30}));
+  ASSERT_EQ(out.got.size(), 7u);
+  EXPECT_TRUE(starts_with(out.got[6].reason, "P1_INVALID")) << out.got[6].reason;
+  EXPECT_NEAR(out.got[6].gp_grasp[0], 0.20, kTol);
+  EXPECT_NEAR(out.got[6].gp_grasp[1], 0.229, kTol);
+  // From there BwH centres the tall book's corner (grasp (0.30, 0.217)): grasped.
+  corner_converged(1400000, 4, 0, {0.45, -0.267, 0.30});
+  ASSERT_EQ(out.got.size(), 8u);
+  EXPECT_TRUE(starts_with(out.got[7].reason, "GRASP")) << out.got[7].reason;
+  EXPECT_NEAR(out.got[7].gp_grasp[0], 0.30, kTol);
+  EXPECT_NEAR(out.got[7].gp_grasp[1], 0.217, kTol);
+}
+
 TEST_F(ArbiterNodeTest, NoRegionLeftGivesNoGrasp) {
   first_run({0.61, -0.30, 0.25}, {0.45, -0.305, 0.10});
   corner_converged(5000, 2, 2, {0.45, -0.33, 0.25});
@@ -699,7 +732,9 @@ TEST(ArbiterConfig, BadDepthKeysNameTheKey) {
            {"stereo_front.probe_left_of_ps_m", "probe_left_of_ps_m: [0.002, 0.010]",
             "probe_left_of_ps_m: [0.01, 0.002]"},
            {"stereo_front.depth_range_m", "depth_range_m: [-0.05, 0.20]", "depth_range_m: [0.20, -0.05]"},
-           {"stereo_front.max_tilt_deg", "max_tilt_deg: 20.0", "max_tilt_deg: 95"}}) {
+           {"stereo_front.max_tilt_deg", "max_tilt_deg: 20.0", "max_tilt_deg: 95"},
+           {"tolerances.raised_bwh_start_m", "raised_bwh_start_m: 0.10", "raised_bwh_start_m: 0.5"},
+           {"tolerances.invalid_p1_over_p2", "invalid_p1_over_p2: true", "invalid_p1_over_p2: 0.2"}}) {
     std::string text = shipped;
     const auto pos = text.find(line);
     ASSERT_NE(pos, std::string::npos) << line;

@@ -427,6 +427,74 @@ TEST(CombinationStrategy, WithoutAValidP1AP2FarLeftOfAMeasuredPsRaisesTheNextBwh
   EXPECT_TRUE(validate_p1(valid, tol).bwh_start.isApprox(V(0.22, 0.099, 0.40), 1e-12));
 }
 
+TEST(CombinationStrategy, AP2LeftOfAndBelowAnInvalidP1OnItsLeftRaisesTheNextBwhStartAtAnyPs) {
+  // Seed 1's fifth book (deployed demo, stop 30): PS = GP.y - BW after the fourth grasp (not measured). The 0.29 m
+  // right-most book leans left: its corner P1 lies 13 mm left of PS (invalid). BwH from PS centred the 0.17 m
+  // neighbour's corner 30 mm left of and 125 mm below P1; the paper's rules grasp it (P2 left of PS).
+  CombinationTolerances tol = kTol;
+  tol.p2_ps_y = 0.010;
+  tol.raised_bwh_start_x = 0.10;
+  tol.invalid_p1_over_p2 = true;
+  CombinationInputs in;
+  in.ps = kPs;  // (0.00, 0.100, 0.50), the estimate
+  in.front_z_fallback = 0.42;
+  in.p1 = V(0.30, 0.087, 0.40);
+  in.p2 = V(0.175, 0.057, 0.45);
+  const CombinationResult r = combine(in, tol);
+  EXPECT_EQ(outcome_name(r.outcome), "RAISE_BWH_START");
+  ASSERT_FALSE(r.steps.empty());
+  EXPECT_EQ(r.steps.back().rule, "P2 vs invalid P1 (left and below)");
+  EXPECT_NEAR(r.steps.back().value, -0.030, 1e-12);
+  EXPECT_NE(r.steps.back().decision.find("30.0 mm left of and 125.0 mm below the invalid P1, which lies 13.0 mm left "
+                                         "of PS"),
+            std::string::npos)
+      << r.steps.back().decision;
+  // The rule off, or no raise configured: the paper's grasp at the neighbour's corner.
+  CombinationTolerances off = tol;
+  off.invalid_p1_over_p2 = false;
+  EXPECT_EQ(combine(in, off).outcome, GraspOutcome::kGrasp);
+  CombinationTolerances no_raise = tol;
+  no_raise.raised_bwh_start_x = 0.0;
+  EXPECT_EQ(combine(in, no_raise).outcome, GraspOutcome::kGrasp);
+  // P2 at P1's book (left of PS by the lean, not below P1): grasped.
+  CombinationInputs same_book = in;
+  same_book.p2 = V(0.295, 0.088, 0.45);
+  EXPECT_EQ(combine(same_book, tol).outcome, GraspOutcome::kGrasp);
+  // P2 left of P1 but not below it by more than x (2 cm): the paper's rules.
+  CombinationInputs level = in;
+  level.p2 = V(0.285, 0.057, 0.45);
+  EXPECT_EQ(combine(level, tol).outcome, GraspOutcome::kGrasp);
+  // P2 below P1 but within y (1.5 cm) of it in Y: the paper's rules.
+  CombinationInputs near_y = in;
+  near_y.p2 = V(0.175, 0.073, 0.45);
+  EXPECT_EQ(combine(near_y, tol).outcome, GraspOutcome::kGrasp);
+  // P1 invalid on the right of PS (not a book between P2 and PS): the paper's rules.
+  CombinationInputs right = in;
+  right.p1 = V(0.30, 0.113, 0.40);
+  right.p2 = V(0.175, 0.083, 0.45);
+  EXPECT_EQ(combine(right, tol).outcome, GraspOutcome::kGrasp);
+  // A valid P1 (5 mm left of PS) is not this rule's: P2 left of and below it is grasped by the paper's Y rule,
+  // GP.x = P1.x.
+  CombinationInputs valid = in;
+  valid.p1 = V(0.30, 0.095, 0.40);
+  const CombinationResult v = combine(valid, tol);
+  EXPECT_EQ(v.outcome, GraspOutcome::kGrasp);
+  EXPECT_TRUE(v.p1_valid);
+  // From the raised start the same neighbour's corner again: no grasp.
+  CombinationInputs raised = in;
+  raised.bwh_start_raised = true;
+  const CombinationResult again = combine(raised, tol);
+  EXPECT_EQ(again.outcome, GraspOutcome::kNoGrasp);
+  ASSERT_FALSE(again.steps.empty());
+  EXPECT_NE(again.steps.back().decision.find("from the raised start too"), std::string::npos)
+      << again.steps.back().decision;
+  // From the raised start the tall book's own corner: grasped there (P2 left of PS is accepted without a valid P1).
+  raised.p2 = V(0.298, 0.088, 0.45);
+  const CombinationResult tall = combine(raised, tol);
+  EXPECT_EQ(tall.outcome, GraspOutcome::kGrasp);
+  EXPECT_TRUE(tall.gp.head<2>().isApprox(V(0.298, 0.088, 0).head<2>(), 1e-12)) << tall.gp.transpose();
+}
+
 TEST(CombinationStrategy, NextPsAfterAGrasp) {
   // GP.y = 0.105, a 2.3 cm book: the next book's right edge is expected at 0.082.
   const V ps = next_ps(kPs, V(0.1, 0.105, 0.4), 0.023);
