@@ -205,7 +205,8 @@ CombinationResult combine(const CombinationInputs& in, const CombinationToleranc
     const double dx1 = p2.x() - in.p1->x();
     if (dy1 <= -tol.y && dx1 <= -tol.x) {
       std::string why = "P2 is " + mm(-dy1) + " left of and " + mm(-dx1) + " below the invalid P1, which lies " +
-                        mm(in.ps.y() - in.p1->y()) + " left of PS: P1's book stands between, P2 is a neighbour's corner";
+                        mm(in.ps.y() - in.p1->y()) +
+                        " left of PS: P1's book stands between, P2 is a neighbour's corner";
       if (in.bwh_start_raised) {
         r.outcome = GraspOutcome::kNoGrasp;
         why += " (from the raised start too): no grasp";

@@ -434,7 +434,8 @@ TEST_F(ArbiterNodeTest, ANeighbourCornerUnderAnInvalidP1RaisesTheNextBwhStartAft
   // P2 grasp (0.17, 0.186): 30 mm left of and 130 mm below P1.
   corner_converged(1200000, 3, 0, {0.45, -0.236, 0.17});
   ASSERT_EQ(out.got.size(), 6u);
-  EXPECT_TRUE(starts_with(out.got[5].reason, "RAISE_BWH_START: P2 is 30.0 mm left of and 130.0 mm below the invalid P1"))
+  EXPECT_TRUE(
+      starts_with(out.got[5].reason, "RAISE_BWH_START: P2 is 30.0 mm left of and 130.0 mm below the invalid P1"))
       << out.got[5].reason;
   EXPECT_FALSE(out.got[5].valid);
   // The next P1 check: BwH starts from PS 100 mm higher.
