@@ -401,6 +401,11 @@ void ArbiterNode::decide(const servo_status_t& msg) {
       raised_at_ps_ = ps_;
       open_attempt();
       break;
+    case GraspOutcome::kStartFromP1:
+      m.reason = "START_FROM_P1: " + last;
+      p1_between_at_ps_ = ps_;
+      open_attempt();
+      break;
     case GraspOutcome::kNoGrasp:
       m.reason = "NO_GRASP: " + last;
       open_attempt();
@@ -419,6 +424,7 @@ CombinationInputs ArbiterNode::common_inputs() const {
   in.ps_measured = ps_measured_;
   in.p1_led_astray = same_stripe_end(p1_astray_at_ps_, *ps_);
   in.bwh_start_raised = same_stripe_end(raised_at_ps_, *ps_);
+  in.p1_between = same_stripe_end(p1_between_at_ps_, *ps_);
   if (corner_at_ps_ && corner_at_ps_->ps == *ps_) in.earlier_corner_z = corner_at_ps_->z;
   in.front_z_fallback = s_.book_front_z;
   in.stereo_front_z = stereo_front_z(in.ps);

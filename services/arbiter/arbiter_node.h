@@ -139,6 +139,9 @@ class ArbiterNode : public Component {
   /// The PS (base) at which BwH from PS found a shorter left neighbour's corner (GraspOutcome::kRaiseBwhStart): at
   /// the same PS (within 3 mm), BwH starts higher.
   std::optional<Eigen::Vector3d> raised_at_ps_;
+  /// The PS (base) at which BwH from PS found a corner left of and below a P1 on PS's left (GraspOutcome::
+  /// kStartFromP1): at the same PS (within 3 mm), such a P1 is used.
+  std::optional<Eigen::Vector3d> p1_between_at_ps_;
   /// R's depth (grasp Z) the corner servo triangulated for the last GRASP, and the PS (base) it was decided at:
   /// CombinationInputs::earlier_corner_z while PS stays that one (a failed attempt at the same book).
   struct CornerAtPs {

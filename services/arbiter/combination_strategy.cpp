@@ -32,6 +32,8 @@ std::string outcome_name(GraspOutcome o) {
       return "P1_LED_ASTRAY";
     case GraspOutcome::kRaiseBwhStart:
       return "RAISE_BWH_START";
+    case GraspOutcome::kStartFromP1:
+      return "START_FROM_P1";
     case GraspOutcome::kNoGrasp: return "NO_GRASP";
   }
   return "?";
@@ -88,6 +90,15 @@ CombinationResult validate_p1_against_ps(const CombinationInputs& in, const Comb
                            "P1 (" + mm(d) +
                                " from PS) led BwH to a left neighbour's corner at this PS before: "
                                "ignore BwS, BwH starts from PS"));
+    return r;
+  }
+  if (in.p1_between && tol.invalid_p1_over_p2 && d < -tol.p1_ps_y) {
+    r.p1_valid = true;
+    r.bwh_start = *in.p1;
+    r.steps.push_back(step("P1 between P2 and PS", d, tol.p1_ps_y, true,
+                           "P1 (" + mm(d) +
+                               " from PS) stood between PS and a neighbour's corner at this PS before: its book is "
+                               "the right-most, leaning left; BwH starts from P1"));
     return r;
   }
   if (std::abs(d) <= tol.p1_ps_y) {
@@ -198,23 +209,23 @@ CombinationResult combine(const CombinationInputs& in, const CombinationToleranc
   // Not in the paper: an invalid P1 left of PS with P2 left of and below it: P1's (taller) book stands between P2's
   // and PS, so P2 is not the right-most book's corner (deployed demo, seed 1's fifth book: P1 on the 0.29 m right-most
   // book leaning left, 13 mm left of GP.y - BW; BwH from PS centred the 0.17 m neighbour's corner 30 mm left of P1).
-  // With a measured PS the rule above has answered already (P2 would lie > y + p1_ps_y left of PS).
-  if (!r.p1_valid && tol.invalid_p1_over_p2 && tol.raised_bwh_start_x > 0 && in.p1 && in.p1->allFinite() &&
+  // START_FROM_P1; from that P1 (p1_between) such a P2 again gets no grasp. With a measured PS the rule above has
+  // answered already (P2 would lie more than y + p1_ps_y left of PS).
+  if (tol.invalid_p1_over_p2 && (!r.p1_valid || in.p1_between) && in.p1 && in.p1->allFinite() &&
       in.p1->y() - in.ps.y() < -tol.p1_ps_y) {
     const double dy1 = p2.y() - in.p1->y();
     const double dx1 = p2.x() - in.p1->x();
     if (dy1 <= -tol.y && dx1 <= -tol.x) {
-      std::string why = "P2 is " + mm(-dy1) + " left of and " + mm(-dx1) + " below the invalid P1, which lies " +
-                        mm(in.ps.y() - in.p1->y()) +
-                        " left of PS: P1's book stands between, P2 is a neighbour's corner";
-      if (in.bwh_start_raised) {
+      std::string why = "P2 is " + mm(-dy1) + " left of and " + mm(-dx1) + " below the P1 that lies " +
+                        mm(in.ps.y() - in.p1->y()) + " left of PS: P1's book stands between, P2 is a neighbour's corner";
+      if (in.p1_between) {
         r.outcome = GraspOutcome::kNoGrasp;
-        why += " (from the raised start too): no grasp";
+        why += " (BwH from P1 too): no grasp";
       } else {
-        r.outcome = GraspOutcome::kRaiseBwhStart;
-        why += "; the next attempt starts BwH " + mm(tol.raised_bwh_start_x) + " higher";
+        r.outcome = GraspOutcome::kStartFromP1;
+        why += "; the next attempt starts BwH from P1";
       }
-      r.steps.push_back(step("P2 vs invalid P1 (left and below)", dy1, tol.y, false, why));
+      r.steps.push_back(step("P2 vs P1 left of PS (left and below)", dy1, tol.y, false, why));
       return r;
     }
   }

@@ -50,9 +50,10 @@ struct CombinationTolerances {
   double raised_bwh_start_x = 0.0;
   /// Not in the paper: without a valid P1, a P2 more than `y` left of and more than `x` below a P1 that failed the PS
   /// check on its left is a shorter left neighbour's corner: P1's book stands between it and PS. The right-most book
-  /// is tall, leans left (its top corner fails the PS check measured at the stripe's height) and its corner lies
-  /// above the hand camera's view from PS. For any PS, measured or the estimate GP.y - BW (the p2_ps_y rule covers
-  /// only a measured one). kRaiseBwhStart as for p2_ps_y, kNoGrasp once raised. Needs raised_bwh_start_x > 0.
+  /// is tall and leans left (its top corner fails the check against PS, which lies at the stripe's height) and its
+  /// corner lies above the hand camera's view from PS. For any PS, measured or the estimate GP.y - BW (with a
+  /// measured one the p2_ps_y rule answers first). No grasp (kStartFromP1); the next check at this PS takes that P1
+  /// as valid (CombinationInputs::p1_between) and BwH starts from it. Such a P2 from there gets kNoGrasp.
   bool invalid_p1_over_p2 = false;
 };
 
@@ -76,6 +77,9 @@ enum class GraspOutcome {
   /// Without a valid P1, BwH from PS found a corner left of the measured PS (CombinationTolerances::
   /// raised_bwh_start_x): no grasp; the next attempt starts BwH from PS raised in X.
   kRaiseBwhStart,
+  /// Without a valid P1, BwH from PS found a corner left of and below a P1 that failed the PS check on its left
+  /// (CombinationTolerances::invalid_p1_over_p2): no grasp; the next attempt starts BwH from that P1.
+  kStartFromP1,
 };
 
 /// Inputs of one decision. P1 from BwS (may be missing), PS from BSwH or the
@@ -111,6 +115,9 @@ struct CombinationInputs {
   /// At this PS, BwH from PS (no valid P1) found a corner more than CombinationTolerances::p2_ps_y left of it before:
   /// BwH starts CombinationTolerances::raised_bwh_start_x higher.
   bool bwh_start_raised = false;
+  /// At this PS, BwH from PS found a corner left of and below a P1 that failed the PS check on its left before
+  /// (CombinationTolerances::invalid_p1_over_p2): such a P1 is taken as valid, its book standing between.
+  bool p1_between = false;
 };
 
 /// Result: GP (grasp frame) and every step.

@@ -1140,9 +1140,10 @@ void LibraryCycle::handle_grasp_decision(const DecisionEvent& d) {
     rank_ = d.next_rank;
     message_ = d.reason;
     succeed(CycleState::kMoveToBwhStart);
-  } else if (d.outcome == "P1_LED_ASTRAY" || d.outcome == "RAISE_BWH_START") {
+  } else if (d.outcome == "P1_LED_ASTRAY" || d.outcome == "RAISE_BWH_START" || d.outcome == "START_FROM_P1") {
     // Not a failed attempt: BwH centred a neighbour's corner, and the arbiter's next P1 check sends BwH from PS
-    // (P1_LED_ASTRAY: BwS's P1 took it there) or from higher above PS (RAISE_BWH_START: a tall right-most book). It
+    // (P1_LED_ASTRAY: BwS's P1 took it there), from higher above PS (RAISE_BWH_START: a tall right-most book) or from
+    // the P1 that stood between (START_FROM_P1: a tall right-most book leaning left). It
     // answers each once per PS, so this cannot repeat without bound. The servo is cancelled as after a failure.
     out_.push_back(make_request(CycleRequest::Kind::kServoCancel));
     rerouting_ = true;

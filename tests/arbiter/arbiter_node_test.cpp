@@ -420,8 +420,8 @@ TEST_F(ArbiterNodeTest, ANeighbourCornerFromPsRaisesTheNextBwhStart) {
 
 // After a grasp, PS is the estimate GP.y - BW. The next right-most book is tall and leans left: its P1 fails the PS
 // check on the left; BwH from PS centres a shorter neighbour's corner left of and below P1. No grasp; the next P1
-// check starts BwH higher (tolerances.invalid_p1_over_p2, raised_bwh_start_m), from where the tall book is grasped.
-TEST_F(ArbiterNodeTest, ANeighbourCornerUnderAnInvalidP1RaisesTheNextBwhStartAfterAGrasp) {
+// check takes that P1 as valid (tolerances.invalid_p1_over_p2), and from it the tall book is grasped.
+TEST_F(ArbiterNodeTest, ANeighbourCornerUnderAP1LeftOfPsSendsTheNextBwhToThatP1AfterAGrasp) {
   grasp_decided();
   for (int64_t t = 100000; t <= 400000; t += 100000) send("ARM_STATE", arm(t, 0.031, true));
   ASSERT_EQ(out.got.size(), 4u);
@@ -434,22 +434,19 @@ TEST_F(ArbiterNodeTest, ANeighbourCornerUnderAnInvalidP1RaisesTheNextBwhStartAft
   // P2 grasp (0.17, 0.186): 30 mm left of and 130 mm below P1.
   corner_converged(1200000, 3, 0, {0.45, -0.236, 0.17});
   ASSERT_EQ(out.got.size(), 6u);
-  EXPECT_TRUE(
-      starts_with(out.got[5].reason, "RAISE_BWH_START: P2 is 30.0 mm left of and 130.0 mm below the invalid P1"))
+  EXPECT_TRUE(starts_with(out.got[5].reason, "START_FROM_P1: P2 is 30.0 mm left of and 130.0 mm below the P1"))
       << out.got[5].reason;
   EXPECT_FALSE(out.got[5].valid);
-  // The next P1 check: BwH starts from PS 100 mm higher.
+  // The next P1 check: P1 valid, BwH starts from it.
   send("BOOK_CORNER_STEREO", corner(1300000, "god", true, {0.61, -0.266, 0.30}));
   ASSERT_EQ(out.got.size(), 7u);
-  EXPECT_TRUE(starts_with(out.got[6].reason, "P1_INVALID")) << out.got[6].reason;
-  EXPECT_NEAR(out.got[6].gp_grasp[0], 0.20, kTol);
-  EXPECT_NEAR(out.got[6].gp_grasp[1], 0.229, kTol);
-  // From there BwH centres the tall book's corner (grasp (0.30, 0.217)): grasped.
+  EXPECT_TRUE(starts_with(out.got[6].reason, "P1_VALID")) << out.got[6].reason;
+  expect_vec(out.got[6].gp_grasp, {0.30, 0.216, 0.01}, "BwH start = P1");
+  // From there BwH centres the tall book's corner (grasp (0.30, 0.217)): grasped at it, GP.z = P1.z.
   corner_converged(1400000, 4, 0, {0.45, -0.267, 0.30});
   ASSERT_EQ(out.got.size(), 8u);
   EXPECT_TRUE(starts_with(out.got[7].reason, "GRASP")) << out.got[7].reason;
-  EXPECT_NEAR(out.got[7].gp_grasp[0], 0.30, kTol);
-  EXPECT_NEAR(out.got[7].gp_grasp[1], 0.217, kTol);
+  expect_vec(out.got[7].gp_grasp, {0.30, 0.217, 0.01}, "GP at the tall book's corner");
 }
 
 TEST_F(ArbiterNodeTest, NoRegionLeftGivesNoGrasp) {

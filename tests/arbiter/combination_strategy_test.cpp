@@ -427,13 +427,11 @@ TEST(CombinationStrategy, WithoutAValidP1AP2FarLeftOfAMeasuredPsRaisesTheNextBwh
   EXPECT_TRUE(validate_p1(valid, tol).bwh_start.isApprox(V(0.22, 0.099, 0.40), 1e-12));
 }
 
-TEST(CombinationStrategy, AP2LeftOfAndBelowAnInvalidP1OnItsLeftRaisesTheNextBwhStartAtAnyPs) {
+TEST(CombinationStrategy, AP2LeftOfAndBelowAnInvalidP1OnItsLeftSendsBwhToThatP1AtAnyPs) {
   // Seed 1's fifth book (deployed demo, stop 30): PS = GP.y - BW after the fourth grasp (not measured). The 0.29 m
   // right-most book leans left: its corner P1 lies 13 mm left of PS (invalid). BwH from PS centred the 0.17 m
   // neighbour's corner 30 mm left of and 125 mm below P1; the paper's rules grasp it (P2 left of PS).
   CombinationTolerances tol = kTol;
-  tol.p2_ps_y = 0.010;
-  tol.raised_bwh_start_x = 0.10;
   tol.invalid_p1_over_p2 = true;
   CombinationInputs in;
   in.ps = kPs;  // (0.00, 0.100, 0.50), the estimate
@@ -441,21 +439,17 @@ TEST(CombinationStrategy, AP2LeftOfAndBelowAnInvalidP1OnItsLeftRaisesTheNextBwhS
   in.p1 = V(0.30, 0.087, 0.40);
   in.p2 = V(0.175, 0.057, 0.45);
   const CombinationResult r = combine(in, tol);
-  EXPECT_EQ(outcome_name(r.outcome), "RAISE_BWH_START");
+  EXPECT_EQ(outcome_name(r.outcome), "START_FROM_P1");
   ASSERT_FALSE(r.steps.empty());
-  EXPECT_EQ(r.steps.back().rule, "P2 vs invalid P1 (left and below)");
+  EXPECT_EQ(r.steps.back().rule, "P2 vs P1 left of PS (left and below)");
   EXPECT_NEAR(r.steps.back().value, -0.030, 1e-12);
-  EXPECT_NE(r.steps.back().decision.find("30.0 mm left of and 125.0 mm below the invalid P1, which lies 13.0 mm left "
-                                         "of PS"),
+  EXPECT_NE(r.steps.back().decision.find("30.0 mm left of and 125.0 mm below the P1 that lies 13.0 mm left of PS"),
             std::string::npos)
       << r.steps.back().decision;
-  // The rule off, or no raise configured: the paper's grasp at the neighbour's corner.
+  // The rule off: the paper's grasp at the neighbour's corner.
   CombinationTolerances off = tol;
   off.invalid_p1_over_p2 = false;
   EXPECT_EQ(combine(in, off).outcome, GraspOutcome::kGrasp);
-  CombinationTolerances no_raise = tol;
-  no_raise.raised_bwh_start_x = 0.0;
-  EXPECT_EQ(combine(in, no_raise).outcome, GraspOutcome::kGrasp);
   // P2 at P1's book (left of PS by the lean, not below P1): grasped.
   CombinationInputs same_book = in;
   same_book.p2 = V(0.295, 0.088, 0.45);
@@ -473,26 +467,45 @@ TEST(CombinationStrategy, AP2LeftOfAndBelowAnInvalidP1OnItsLeftRaisesTheNextBwhS
   right.p1 = V(0.30, 0.113, 0.40);
   right.p2 = V(0.175, 0.083, 0.45);
   EXPECT_EQ(combine(right, tol).outcome, GraspOutcome::kGrasp);
-  // A valid P1 (5 mm left of PS) is not this rule's: P2 left of and below it is grasped by the paper's Y rule,
-  // GP.x = P1.x.
+  // A valid P1 (5 mm left of PS) is not this rule's: P2 left of and below it is grasped by the paper's Y rule.
   CombinationInputs valid = in;
   valid.p1 = V(0.30, 0.095, 0.40);
   const CombinationResult v = combine(valid, tol);
   EXPECT_EQ(v.outcome, GraspOutcome::kGrasp);
   EXPECT_TRUE(v.p1_valid);
-  // From the raised start the same neighbour's corner again: no grasp.
-  CombinationInputs raised = in;
-  raised.bwh_start_raised = true;
-  const CombinationResult again = combine(raised, tol);
+  // A measured PS: the measured-PS rule answers first (P2 43 mm left of it; the tall book's corner lies above BwH's
+  // view from PS, RAISE_BWH_START), as before this rule.
+  CombinationTolerances measured_tol = tol;
+  measured_tol.p2_ps_y = 0.010;
+  measured_tol.raised_bwh_start_x = 0.10;
+  CombinationInputs measured = in;
+  measured.ps_measured = true;
+  EXPECT_EQ(outcome_name(combine(measured, measured_tol).outcome), "RAISE_BWH_START");
+
+  // The next check at the same PS: that P1 is taken as valid, BwH starts from it (its own depth).
+  in.p1_between = true;
+  const CombinationResult check = validate_p1(in, tol);
+  EXPECT_TRUE(check.p1_valid);
+  EXPECT_TRUE(check.bwh_start.isApprox(V(0.30, 0.087, 0.40), 1e-12)) << check.bwh_start.transpose();
+  ASSERT_FALSE(check.steps.empty());
+  EXPECT_EQ(check.steps.back().rule, "P1 between P2 and PS");
+  // ... but not with the rule off, nor a P1 right of PS.
+  EXPECT_FALSE(validate_p1(in, off).p1_valid);
+  CombinationInputs right_between = right;
+  right_between.p1_between = true;
+  EXPECT_FALSE(validate_p1(right_between, tol).p1_valid);
+  // From P1 the tall book's corner: GP there, GP.z = P1.z.
+  in.p2 = V(0.298, 0.088, 0.45);
+  const CombinationResult tall = combine(in, tol);
+  EXPECT_EQ(tall.outcome, GraspOutcome::kGrasp);
+  EXPECT_TRUE(tall.gp.isApprox(V(0.298, 0.088, 0.40), 1e-12)) << tall.gp.transpose();
+  // From P1 the same neighbour's corner again: no grasp (not GP at P1.x over the neighbour).
+  in.p2 = V(0.175, 0.057, 0.45);
+  const CombinationResult again = combine(in, tol);
   EXPECT_EQ(again.outcome, GraspOutcome::kNoGrasp);
   ASSERT_FALSE(again.steps.empty());
-  EXPECT_NE(again.steps.back().decision.find("from the raised start too"), std::string::npos)
+  EXPECT_NE(again.steps.back().decision.find("(BwH from P1 too): no grasp"), std::string::npos)
       << again.steps.back().decision;
-  // From the raised start the tall book's own corner: grasped there (P2 left of PS is accepted without a valid P1).
-  raised.p2 = V(0.298, 0.088, 0.45);
-  const CombinationResult tall = combine(raised, tol);
-  EXPECT_EQ(tall.outcome, GraspOutcome::kGrasp);
-  EXPECT_TRUE(tall.gp.head<2>().isApprox(V(0.298, 0.088, 0).head<2>(), 1e-12)) << tall.gp.transpose();
 }
 
 TEST(CombinationStrategy, NextPsAfterAGrasp) {

@@ -540,8 +540,9 @@ TEST(LibraryCycle, BadDepthKeysNameTheKey) {
 }
 
 TEST(LibraryCycle, AReRoutedCornerSearchParksAndChecksP1AgainWithinTheSameAttempt) {
-  // P1_LED_ASTRAY (BwH from PS next) and RAISE_BWH_START (BwH from higher above PS next) are handled alike.
-  for (const std::string outcome : {"P1_LED_ASTRAY", "RAISE_BWH_START"}) {
+  // P1_LED_ASTRAY (BwH from PS next), RAISE_BWH_START (BwH from higher above PS next) and START_FROM_P1 (BwH from
+  // the P1 left of PS next) are handled alike.
+  for (const std::string outcome : {"P1_LED_ASTRAY", "RAISE_BWH_START", "START_FROM_P1"}) {
     SCOPED_TRACE(outcome);
     FakeLibrary w(three_books());
     w.reroute_once = 1;
