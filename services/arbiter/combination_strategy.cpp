@@ -217,7 +217,8 @@ CombinationResult combine(const CombinationInputs& in, const CombinationToleranc
     const double dx1 = p2.x() - in.p1->x();
     if (dy1 <= -tol.y && dx1 <= -tol.x) {
       std::string why = "P2 is " + mm(-dy1) + " left of and " + mm(-dx1) + " below the P1 that lies " +
-                        mm(in.ps.y() - in.p1->y()) + " left of PS: P1's book stands between, P2 is a neighbour's corner";
+                        mm(in.ps.y() - in.p1->y()) +
+                        " left of PS: P1's book stands between, P2 is a neighbour's corner";
       if (in.p1_between) {
         r.outcome = GraspOutcome::kNoGrasp;
         why += " (BwH from P1 too): no grasp";

@@ -368,8 +368,8 @@ class LibraryCycle {
   std::vector<CycleRequest> out_;
   int attempt_ = 1;
   int step_retries_ = 0;
-  /// The stripe end was measured in this attempt, or the attempt re-routes BwH (P1_LED_ASTRAY, RAISE_BWH_START, START_FROM_P1) at a
-  /// measured PS: a P1 check without P1 starts BwH instead of checking the stripe again.
+  /// The stripe end was measured in this attempt, or the attempt re-routes BwH (P1_LED_ASTRAY, RAISE_BWH_START,
+  /// START_FROM_P1) at a measured PS: a P1 check without P1 starts BwH instead of checking the stripe again.
   bool stripe_done_this_attempt_ = false;
   bool rerouting_ = false;  ///< the arbiter answered a re-route; the next WAIT_P1_CHECK keeps the stripe as measured
   std::optional<double> p1_check_y_;  ///< the grasp Y of P1 at this attempt's P1 check, when BwS found a book
