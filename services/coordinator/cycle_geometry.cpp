@@ -74,6 +74,13 @@ CycleGeometry CycleGeometry::from_config(const Config& c) {
   g.lower_front_z = c.get_double("lower_shelf.front_z_m", -0.2, 0.5);
   g.lower_first_right_y = c.get_double("lower_shelf.first_right_y_m", -3, 3);
   g.lower_gap = c.get_double("lower_shelf.gap_m", 0.0, 0.1);
+  g.lower_release_opening = c.get_double("lower_shelf.release_opening_m", 0.0, 0.06);
+  if (g.lower_release_opening > 0 && g.lower_gap < g.plate_thickness + 0.5 * g.lower_release_opening)
+    throw ConfigError(c.source() + ": " + c.path_of("lower_shelf.gap_m") + " (" + std::to_string(g.lower_gap) +
+                      ") must be at least " + c.path_of("grasp.plate_thickness_m") + " + " +
+                      c.path_of("lower_shelf.release_opening_m") + " / 2 (" +
+                      std::to_string(g.plate_thickness + 0.5 * g.lower_release_opening) +
+                      "): the right plate would push the book placed before over");
   g.lower_left_y = c.get_double("lower_shelf.left_y_m", -3, 3);
   if (g.lower_first_right_y <= g.lower_left_y)
     throw ConfigError(c.source() + ": " + c.path_of("lower_shelf.first_right_y_m") + " must be right of " +
@@ -251,6 +258,10 @@ std::vector<Eigen::Isometry3d> holder_lift_moves(const Eigen::Isometry3d& s, dou
 double lower_shelf_max_book_height(const CycleGeometry& g) {
   if (g.lower_shelf_gap <= 0) return std::numeric_limits<double>::infinity();
   return g.lower_shelf_gap - 2 * g.lower_book_clearance;
+}
+
+double lower_release_width(double book_width, const CycleGeometry& g) {
+  return g.lower_release_opening > 0 ? book_width + g.lower_release_opening : 0.0;
 }
 
 double next_lower_right_y(double right_y, double book_width, const CycleGeometry& g) {

@@ -92,6 +92,9 @@ struct CycleGeometry {
   double lower_front_z = 0.01;      ///< fore-edges' plane on the lower shelf, grasp Z
   double lower_first_right_y = 0.38;///< right cover of the first book placed, grasp Y
   double lower_gap = 0.003;         ///< between books placed on the lower shelf
+  /// At the release on the lower shelf the plates open this much wider than the book (0 = fully): a full opening
+  /// swings the right plate into the book placed before.
+  double lower_release_opening = 0.0;
   double lower_left_y = -0.40;      ///< inner left end of the lower shelf, grasp Y
   Eigen::Vector3d lower_pre_place_offset = Eigen::Vector3d::Zero();  ///< pre-place = place + this (grasp)
   double lower_retreat = 0.30;      ///< after release, out along -Z
@@ -168,6 +171,10 @@ PlateOpening plate_opening_clear_of_right_panel(const PlateOpening& o, double gp
 /// How far (m) the palm reaches past right_panel_clearance from the right side panel for a GP at grasp Y `gp_y`
 /// with the opening `o` (> 0: it meets the panel or comes too near; <= 0: clear). 0 with palm_half_width 0.
 double palm_over_right_panel(const PlateOpening& o, double gp_y, const CycleGeometry& g);
+
+/// The plate opening to release a book `book_width` wide on the lower shelf: the book plus
+/// `lower_release_opening`, or 0 (the gripper's full opening) when that is 0.
+double lower_release_width(double book_width, const CycleGeometry& g);
 
 bool holds_more_than_the_book(double plate_distance, const ForeEdges& edges, const CycleGeometry& g);
 /// Book height above its support at the TCP: GP.x (top above the upper shelf) plus the X offset.

@@ -780,8 +780,11 @@ void LibraryCycle::enter(CycleState s) {
       break;
     case CycleState::kOpenForHolderGrasp:
     case CycleState::kReleaseOnHolder:
-    case CycleState::kReleaseOnLowerShelf:
       start_gripper(false);
+      break;
+    case CycleState::kReleaseOnLowerShelf:
+      // Not wider than the book needs: the right plate stands in the gap to the book placed before.
+      start_gripper(false, lower_release_width(progress_.book_width, g));
       break;
     case CycleState::kInsert:
       start_linear({grasp_pose(gp_base_, grasp_geometry())});

@@ -247,6 +247,14 @@ TEST(CycleGeometry, TheNextLowerShelfSlotIsLeftOfTheBookAndTheGap) {
   EXPECT_NEAR(next_lower_right_y(0.10, 0.02, g), 0.077, 1e-12);  // grasp Y grows to the right
 }
 
+TEST(CycleGeometry, TheReleaseOnTheLowerShelfOpensThePlatesOnlyAFewMillimetresOverTheBook) {
+  CycleGeometry g = geometry();
+  g.lower_release_opening = 0.006;
+  EXPECT_NEAR(lower_release_width(0.021, g), 0.027, 1e-12);
+  g.lower_release_opening = 0.0;
+  EXPECT_EQ(lower_release_width(0.021, g), 0.0) << "0: the gripper's full opening";
+}
+
 TEST(CycleGeometry, ADiagonalLiftEndsOutAndUpInOneLineAndTheRetreatStaysWithin) {
   CycleGeometry g = geometry();
   g.extract_lift = 0.34;
