@@ -124,6 +124,8 @@ void write_report(const std::string& dir, const EvalMetrics& m, const std::strin
   md << "| books no grasp targeted that left the upper shelf | " << m.untargeted_books_off_the_upper_shelf
      << " | - |\n";
   md << "| books through the whole cycle | " << pct(m.books_moved, m.books_targeted) << " | - |\n";
+  md << "| ... of them standing upright on the lower shelf at the end (scenes that checked) | "
+     << pct(m.books_upright_on_lower_shelf, m.books_upright_checked) << " | - |\n";
   md << "| books left on the holder for the librarian: too tall for the lower shelf / not placeable there | "
      << m.books_handed_over - m.books_handed_over_unplaceable << " / " << m.books_handed_over_unplaceable << " | - |\n";
   md << "| P1-P2 agreement (|dY| <= 15 mm, |dX| <= 20 mm) | " << pct(m.decisions_agreeing, m.decisions) << " | 80 % |\n";

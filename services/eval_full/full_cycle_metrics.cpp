@@ -42,6 +42,20 @@ std::string final_place(const FullCycleResult& r, const BookRecord& b) {
   return "unknown";
 }
 
+double final_tilt_deg(const FullCycleResult& r, const BookRecord& b) {
+  for (const auto& t : r.final_truth.books) {
+    if (t.id != b.truth_id) continue;
+    // The book body's Z is its height axis (scene.cpp: corners at +-height/2 along it); pose in base, Z up.
+    const double w = t.pose.orientation[0], x = t.pose.orientation[1], y = t.pose.orientation[2],
+                 z = t.pose.orientation[3];
+    const double n2 = w * w + x * x + y * y + z * z;
+    if (!(n2 > 0)) return NAN;
+    const double up_z = (w * w - x * x - y * y + z * z) / n2;  // R(2,2) of the unit quaternion
+    return std::acos(std::clamp(up_z, -1.0, 1.0)) * 180.0 / M_PI;
+  }
+  return NAN;
+}
+
 std::vector<int> untargeted_books_off_the_upper_shelf(const FullCycleResult& r) {
   std::vector<int> ids;
   for (const auto& t : r.final_truth.books) {
@@ -74,6 +88,12 @@ std::string failure_reason(const FullCycleResult& r, int max_books) {
     const std::string place = final_place(r, b);
     if (b.moved && !b.handed_over && place != "lower_shelf")
       return "BOOK_NOT_ON_LOWER_SHELF at the end: the book is " + place;
+  }
+  for (const auto& b : r.books) {
+    const double tilt = final_tilt_deg(r, b);
+    if (b.moved && final_place(r, b) == "lower_shelf" && !(tilt <= kUprightMaxTiltDeg))
+      return "BOOK_NOT_UPRIGHT_ON_LOWER_SHELF at the end: it lies tilted by more than " +
+             std::to_string(static_cast<int>(kUprightMaxTiltDeg)) + " deg (knocked over)";
   }
   if (const auto off = untargeted_books_off_the_upper_shelf(r); !off.empty())
     return "OTHER_BOOK_OFF_THE_UPPER_SHELF at the end: " + std::to_string(off.size()) +
@@ -135,6 +155,11 @@ void accumulate(const SceneOutcome& o, int max_books, const MetricTolerances& to
   for (const auto& b : r.books) {
     m->books_handed_over += b.handed_over ? 1 : 0;
     m->books_handed_over_unplaceable += b.handed_over && b.handed_over_unplaceable ? 1 : 0;
+  }
+  for (const auto& b : r.books) {
+    if (!b.moved || final_place(r, b) != "lower_shelf") continue;
+    ++m->books_upright_checked;
+    m->books_upright_on_lower_shelf += final_tilt_deg(r, b) <= kUprightMaxTiltDeg ? 1 : 0;
   }
   for (const auto& b : r.books) m->books_carried_along += static_cast<int>(b.carried_along.size());
   m->untargeted_books_off_the_upper_shelf += static_cast<int>(untargeted_books_off_the_upper_shelf(r).size());
@@ -236,6 +261,9 @@ std::string metrics_json(const EvalMetrics& m, const std::string& command) {
   j << "  \"holder_releases\": " << m.holder_releases << ",\n";
   j << "  \"holder_placed_rate\": " << rate(m.holder_placed, m.holder_releases) << ",\n";
   j << "  \"holder_standing_rate\": " << rate(m.holder_standing, m.holder_retreats) << ",\n";
+  j << "  \"books_upright_checked\": " << m.books_upright_checked << ",\n";
+  j << "  \"books_upright_on_lower_shelf\": " << m.books_upright_on_lower_shelf << ",\n";
+  j << "  \"books_upright_rate\": " << rate(m.books_upright_on_lower_shelf, m.books_upright_checked) << ",\n";
   j << "  \"p1_p2_decisions\": " << m.decisions << ",\n";
   j << "  \"p1_p2_agreement_rate\": " << rate(m.decisions_agreeing, m.decisions) << ",\n";
   j << "  \"widths_measured\": " << m.widths << ",\n";

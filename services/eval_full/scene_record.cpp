@@ -30,6 +30,8 @@ auto counts(M& m) {
       {"holder_placed", &m.holder_placed},
       {"holder_retreats", &m.holder_retreats},
       {"holder_standing", &m.holder_standing},
+      {"books_upright_checked", &m.books_upright_checked},
+      {"books_upright_on_lower_shelf", &m.books_upright_on_lower_shelf},
       {"decisions", &m.decisions},
       {"decisions_agreeing", &m.decisions_agreeing},
       {"widths", &m.widths},
@@ -63,9 +65,10 @@ auto samples(M& m) {
   };
 }
 
-/// Sample keys added after the first scene records (stop 28): a record without them measured none (empty).
+/// Keys added after the first scene records (stop 28: the plate samples; stop 31: the upright counts): a record
+/// without them measured none (empty, 0).
 bool added_later(const std::string& key) {
-  return key.rfind("plates_over_fore_edge_mm_", 0) == 0;
+  return key.rfind("plates_over_fore_edge_mm_", 0) == 0 || key.rfind("books_upright_", 0) == 0;
 }
 
 std::string exact(double v) {
@@ -116,7 +119,8 @@ SceneRecord parse_scene_record(const std::string& text, const std::string& where
     r.options = required(n, "options", where).as<std::string>();
     r.books_per_scene = required(n, "books_per_scene", where).as<int>();
     r.csv_row = required(n, "csv_row", where).as<std::string>();
-    for (const auto& [key, v] : counts(r.metrics)) *v = required(n, key, where).as<int>();
+    for (const auto& [key, v] : counts(r.metrics))
+      if (!added_later(key) || n[key]) *v = required(n, key, where).as<int>();
     for (const auto& [key, v] : samples(r.metrics))
       if (!added_later(key) || n[key]) *v = required(n, key, where).as<std::vector<double>>();
     for (const auto& f : required(n, "failures", where))

@@ -69,6 +69,29 @@ TEST(FullCycleMetrics, AMovedBookCountsOnlyIfTheTruthHasItOnTheLowerShelf) {
   EXPECT_EQ(m.failures[0].second, "BOOK_NOT_ON_LOWER_SHELF at the end: the book is other");
 }
 
+TEST(FullCycleMetrics, ABookKnockedFlatOnTheLowerShelfIsMovedButNotUpright) {
+  // Both books on the lower shelf by the truth; the first lies on its side (90 deg about X), the second leans 10 deg.
+  SceneOutcome o = done_scene(5);
+  auto turn = [](book_truth_t* b, double deg) {
+    b->pose.orientation[0] = std::cos(deg * M_PI / 360);
+    b->pose.orientation[1] = std::sin(deg * M_PI / 360);
+  };
+  turn(&o.result.final_truth.books[0], 90);
+  turn(&o.result.final_truth.books[1], 10);
+  EXPECT_NEAR(final_tilt_deg(o.result, o.result.books[0]), 90, 1e-9);
+  EXPECT_NEAR(final_tilt_deg(o.result, o.result.books[1]), 10, 1e-9);
+  EXPECT_EQ(failure_reason(o.result, 0).rfind("BOOK_NOT_UPRIGHT_ON_LOWER_SHELF at the end", 0), 0u)
+      << failure_reason(o.result, 0);
+  EvalMetrics m;
+  accumulate(o, 0, MetricTolerances{}, &m);
+  EXPECT_EQ(m.books_moved, 2) << "on the lower shelf, whatever its pose";
+  EXPECT_EQ(m.books_upright_checked, 2);
+  EXPECT_EQ(m.books_upright_on_lower_shelf, 1);
+  // Both leaning 10 deg: no failure for it.
+  turn(&o.result.final_truth.books[0], 10);
+  EXPECT_EQ(failure_reason(o.result, 0).find("UPRIGHT"), std::string::npos) << failure_reason(o.result, 0);
+}
+
 TEST(FullCycleMetrics, AHandedOverBookIsCountedApartAndNamedOnlyWhenNothingElseFailed) {
   // The first book was too tall for the lower shelf: the librarian took it (truth: "other"); the second was moved.
   SceneOutcome o = done_scene(5);

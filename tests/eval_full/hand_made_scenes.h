@@ -14,6 +14,7 @@ inline book_truth_t truth_book(const std::string& place, int id = 0) {
   book_truth_t b{};
   b.id = id;
   b.place = place;
+  b.pose.orientation[0] = 1.0;  // upright: the book's height axis along base Z
   return b;
 }
 

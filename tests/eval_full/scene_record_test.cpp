@@ -123,6 +123,24 @@ TEST(SceneRecord, PlateClosesRoundTripAndARecordFromBeforeThemReadsAsNone) {
   EXPECT_EQ(before.metrics.width_error_mm, r.metrics.width_error_mm);
 }
 
+TEST(SceneRecord, UprightCountsRoundTripAndARecordFromBeforeThemReadsAsNoneChecked) {
+  const SceneRecord r = record_of(done_scene(15));
+  ASSERT_EQ(r.metrics.books_upright_checked, 2);
+  ASSERT_EQ(r.metrics.books_upright_on_lower_shelf, 2);
+  const SceneRecord back = parse_scene_record(scene_record_yaml(r), "test");
+  EXPECT_EQ(back.metrics.books_upright_checked, 2);
+  EXPECT_EQ(back.metrics.books_upright_on_lower_shelf, 2);
+  // A stop 30 record (no books_upright_* keys): read, nothing checked.
+  std::string old_text;
+  std::istringstream lines(scene_record_yaml(r));
+  for (std::string line; std::getline(lines, line);)
+    if (line.rfind("books_upright_", 0) != 0) old_text += line + "\n";
+  ASSERT_NE(old_text, scene_record_yaml(r));
+  const SceneRecord before = parse_scene_record(old_text, "stop30/scenes/seed_15.yaml");
+  EXPECT_EQ(before.metrics.books_upright_checked, 0);
+  EXPECT_EQ(before.metrics.books_moved, r.metrics.books_moved);
+}
+
 TEST(SceneRecord, ABadFileIsNamedWithItsKey) {
   std::string text = scene_record_yaml(record_of(done_scene(1)));
   const auto at = text.find("grasp_attempts:");
