@@ -145,8 +145,8 @@ TEST(LibraryCycle, ThreeBooksWholeCycleEveryTransitionAndPlacements) {
   EXPECT_EQ(cycle.status().state, "DONE");
   EXPECT_EQ(cycle.status().books_moved, 3);
 
-  // Lower shelf (coordinator.yaml lower_shelf: first_right_y 0.10, gap 0.018, front_z -0.04, drop 0.32): right covers
-  // at 0.10, 0.10 - 0.025 - 0.018 = 0.057, 0.057 - 0.020 - 0.018 = 0.019; TCP Y = right - BW/2;
+  // Lower shelf (coordinator.yaml lower_shelf: first_right_y 0.10, gap 0.005, front_z -0.04, drop 0.32): right covers
+  // at 0.10, 0.10 - 0.025 - 0.005 = 0.07, 0.07 - 0.020 - 0.005 = 0.045; TCP Y = right - BW/2;
   // Z = -0.04 + 0.03 (insertion) = -0.01. Base = (0.60 + Z, -0.05 - Y, X). X: the book was taken from the holder
   // with the TCP holder.regrasp_lower_m (0.015) lower than at its release, after it had dropped place_clearance_m
   // (0.005) onto the ledge, so the TCP is height - 0.015 + 0.005 above its bottom; the place leaves 0.005 below it:
@@ -154,7 +154,7 @@ TEST(LibraryCycle, ThreeBooksWholeCycleEveryTransitionAndPlacements) {
   // shelf: its top (P1.x) plus grasp.offset_x_m (shipped -0.012: 12 mm below the top).
   const double gx = settings().geometry.grasp_offset_x;
   ASSERT_NEAR(gx, -0.012, 1e-12);
-  const double ys[3] = {0.10 - 0.0125, 0.057 - 0.010, 0.019 - 0.015};
+  const double ys[3] = {0.10 - 0.0125, 0.07 - 0.010, 0.045 - 0.015};
   const double hs[3] = {0.25 + gx, 0.18 + gx, 0.22 + gx};
   for (int i = 0; i < 3; ++i) {
     const Eigen::Vector3d tcp = w.lower[i].second.translation();
@@ -162,13 +162,26 @@ TEST(LibraryCycle, ThreeBooksWholeCycleEveryTransitionAndPlacements) {
     EXPECT_NEAR(tcp.y(), -0.05 - ys[i], 0.0015) << "book " << i;
     EXPECT_NEAR(tcp.z(), -0.32 + hs[i] - 0.015 + 0.005 + 0.005, 0.0015) << "book " << i;
   }
-  // The releases on the lower shelf open the plates to the book + lower_shelf.release_opening_m (6 mm), not fully:
-  // 31, 26 and 36 mm for the 25, 20 and 30 mm books.
-  std::vector<double> narrow_opens;
-  for (const CycleRequest& r : w.requests)
-    if (r.kind == CycleRequest::Kind::kGripperMove && r.width < 0.04) narrow_opens.push_back(r.width);
-  ASSERT_EQ(narrow_opens.size(), 3u);
-  for (int i = 0; i < 3; ++i) EXPECT_NEAR(narrow_opens[i], (std::vector<double>{0.031, 0.026, 0.036})[i], 1e-9);
+  // The releases on the lower shelf open the plates fully (lower_shelf.release_opening_m 0); with 6 mm, to the book
+  // + 6 mm: 31, 26 and 36 mm for the 25, 20 and 30 mm books (the gap then at least a plate + 3 mm).
+  const auto release_opens = [](const FakeLibrary& f) {
+    std::vector<double> v;
+    for (const CycleRequest& r : f.requests)
+      if (r.kind == CycleRequest::Kind::kGripperMove && r.width < 0.04) v.push_back(r.width);
+    return v;
+  };
+  EXPECT_TRUE(release_opens(w).empty());
+  {
+    CycleSettings narrow = settings();
+    narrow.geometry.lower_release_opening = 0.006;
+    FakeLibrary wn(three_books());
+    LibraryCycle cn(narrow, std::nullopt);
+    wn.run(cn, [&] { return done_or_aborted(cn); });
+    ASSERT_EQ(cn.state(), CycleState::kDone) << cn.status().message;
+    const std::vector<double> opens = release_opens(wn);
+    ASSERT_EQ(opens.size(), 3u);
+    for (int i = 0; i < 3; ++i) EXPECT_NEAR(opens[i], (std::vector<double>{0.031, 0.026, 0.036})[i], 1e-9);
+  }
   // The grasp from the holder: over the place in x and y, 0.015 lower (the TCP at release was height + 0.005 above
   // the ledge, support z = base z, ledge at -0.09).
   ASSERT_EQ(w.holder_grasps.size(), 3u);
@@ -533,9 +546,9 @@ TEST(LibraryCycle, BadDepthKeysNameTheKey) {
         {"grasp.more_than_the_book_m", "more_than_the_book_m: 0.0025", "more_than_the_book_m: 0.2"},
         {"grasp.width_left_clearance_m", "width_left_clearance_m: 0.005", "width_left_clearance_m: 0.2"},
         {"holder.regrasp_min_height_m", "regrasp_min_height_m: 0.15", "regrasp_min_height_m: -0.1"},
-        {"lower_shelf.release_opening_m", "release_opening_m: 0.006", "release_opening_m: 0.1"},
-        // Narrower than a plate: the right plate would push the book placed before over.
-        {"lower_shelf.gap_m", "gap_m: 0.018", "gap_m: 0.005"}}) {
+        {"lower_shelf.release_opening_m", "release_opening_m: 0.0 ", "release_opening_m: 0.1 "},
+        // A 6 mm release opening with the 5 mm gap: the right plate would push the book placed before over.
+        {"lower_shelf.gap_m", "release_opening_m: 0.0 ", "release_opening_m: 0.006 "}}) {
     std::string text = shipped;
     const auto pos = text.find(line);
     ASSERT_NE(pos, std::string::npos) << line;
