@@ -105,6 +105,15 @@ TEST(SceneRecord, RefusesRunsThatCannotBeMerged) {
   EXPECT_NE(message({a.string(), empty.string()}).find("holds no scenes"), std::string::npos);
 }
 
+/// A scene record's text without the lines of the keys starting with `prefix`: a record from before they existed.
+std::string without_keys(const std::string& text, const std::string& prefix) {
+  std::string out;
+  std::istringstream lines(text);
+  for (std::string line; std::getline(lines, line);)
+    if (line.rfind(prefix, 0) != 0) out += line + "\n";
+  return out;
+}
+
 TEST(SceneRecord, PlateClosesRoundTripAndARecordFromBeforeThemReadsAsNone) {
   SceneOutcome o = other_scene(14);
   o.result.closes = {{0.0256, 0.0250, "held_alone"}, {0.0310, 0.0250, "double_lift"}};
@@ -113,10 +122,7 @@ TEST(SceneRecord, PlateClosesRoundTripAndARecordFromBeforeThemReadsAsNone) {
   EXPECT_EQ(back.metrics.plates_over_fore_edge_mm[0], r.metrics.plates_over_fore_edge_mm[0]);
   EXPECT_EQ(back.metrics.plates_over_fore_edge_mm[1], r.metrics.plates_over_fore_edge_mm[1]);
   // A stop 27 record (no plates_over_fore_edge_mm_* keys): read, with no closes.
-  std::string old_text;
-  std::istringstream lines(scene_record_yaml(r));
-  for (std::string line; std::getline(lines, line);)
-    if (line.rfind("plates_over_fore_edge_mm_", 0) != 0) old_text += line + "\n";
+  const std::string old_text = without_keys(scene_record_yaml(r), "plates_over_fore_edge_mm_");
   ASSERT_NE(old_text, scene_record_yaml(r));
   const SceneRecord before = parse_scene_record(old_text, "stop27/scenes/seed_14.yaml");
   for (const auto& v : before.metrics.plates_over_fore_edge_mm) EXPECT_TRUE(v.empty());
@@ -131,10 +137,7 @@ TEST(SceneRecord, UprightCountsRoundTripAndARecordFromBeforeThemReadsAsNoneCheck
   EXPECT_EQ(back.metrics.books_upright_checked, 2);
   EXPECT_EQ(back.metrics.books_upright_on_lower_shelf, 2);
   // A stop 30 record (no books_upright_* keys): read, nothing checked.
-  std::string old_text;
-  std::istringstream lines(scene_record_yaml(r));
-  for (std::string line; std::getline(lines, line);)
-    if (line.rfind("books_upright_", 0) != 0) old_text += line + "\n";
+  const std::string old_text = without_keys(scene_record_yaml(r), "books_upright_");
   ASSERT_NE(old_text, scene_record_yaml(r));
   const SceneRecord before = parse_scene_record(old_text, "stop30/scenes/seed_15.yaml");
   EXPECT_EQ(before.metrics.books_upright_checked, 0);
