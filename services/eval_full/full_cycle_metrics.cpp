@@ -1,5 +1,7 @@
 #include "services/eval_full/full_cycle_metrics.h"
 
+#include "services/task_watch/truth_count.h"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -43,16 +45,8 @@ std::string final_place(const FullCycleResult& r, const BookRecord& b) {
 }
 
 double final_tilt_deg(const FullCycleResult& r, const BookRecord& b) {
-  for (const auto& t : r.final_truth.books) {
-    if (t.id != b.truth_id) continue;
-    // The book body's Z is its height axis (scene.cpp: corners at +-height/2 along it); pose in base, Z up.
-    const double w = t.pose.orientation[0], x = t.pose.orientation[1], y = t.pose.orientation[2],
-                 z = t.pose.orientation[3];
-    const double n2 = w * w + x * x + y * y + z * z;
-    if (!(n2 > 0)) return NAN;
-    const double up_z = (w * w - x * x - y * y + z * z) / n2;  // R(2,2) of the unit quaternion
-    return std::acos(std::clamp(up_z, -1.0, 1.0)) * 180.0 / M_PI;
-  }
+  for (const auto& t : r.final_truth.books)
+    if (t.id == b.truth_id) return height_axis_tilt_deg(t.pose);
   return NAN;
 }
 

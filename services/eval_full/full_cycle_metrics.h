@@ -56,7 +56,7 @@ struct EvalMetrics {
   int holder_retreats = 0;                   ///< ... from which the gripper retreated
   int holder_standing = 0;                   ///< ... and that then stood on the ledge (truth)
   /// Books the truth has on the lower shelf at the end (books_moved) in scenes that checked their pose, and of them
-  /// the ones standing within kUprightMaxTiltDeg of upright (not knocked flat). Scene records before stop 31 lack both.
+  /// the ones standing within kUprightMaxTiltDeg (truth_count.h) of upright (not knocked flat). Scene records before stop 31 lack both.
   int books_upright_checked = 0;
   int books_upright_on_lower_shelf = 0;
   int decisions = 0;                         ///< GRASP decisions with a P1
@@ -81,10 +81,6 @@ struct EvalMetrics {
 
 /// Where the simulation's truth has book `b` at the end of the scene ("unknown" if it has no such book).
 std::string final_place(const FullCycleResult& r, const BookRecord& b);
-
-/// A book on the lower shelf stands when its height axis is within this of the vertical (books lean on each other a
-/// few degrees; a knocked-over one lies at 90).
-constexpr double kUprightMaxTiltDeg = 20.0;
 
 /// The tilt of book `b`'s height axis from the vertical (base Z) at the end of the scene, degrees; NaN without truth.
 double final_tilt_deg(const FullCycleResult& r, const BookRecord& b);

@@ -10,10 +10,19 @@
 
 namespace bookgrasp {
 
+/// A book stands when its height axis is within this of the vertical (books lean on each other a few degrees; a
+/// knocked-over one lies at 90).
+constexpr double kUprightMaxTiltDeg = 20.0;
+
+/// The tilt of a book's height axis (its body Z, scene.cpp's corners) from base Z, degrees, for its truth `pose`;
+/// NaN for a zero quaternion.
+double height_axis_tilt_deg(const pose_t& pose);
+
 /// Books per `book_truth_t.place`.
 struct TruthCount {
   int books = 0;
   int lower_shelf = 0;
+  int lower_shelf_upright = 0;  ///< ... of them standing (height_axis_tilt_deg <= kUprightMaxTiltDeg)
   int upper_shelf = 0;
   int holder = 0;
   int gripper = 0;

@@ -3,6 +3,8 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 namespace bookgrasp {
 namespace {
 
@@ -12,6 +14,7 @@ ground_truth_t truth_with(const std::vector<std::string>& places) {
     book_truth_t b{};
     b.id = static_cast<int32_t>(i);
     b.place = places[i];
+    b.pose.orientation[0] = 1.0;  // upright
     gt.books.push_back(b);
   }
   gt.num_books = static_cast<int32_t>(gt.books.size());
@@ -28,8 +31,30 @@ TEST(TruthCount, CountsEveryPlaceAndSaysSo) {
   EXPECT_EQ(c.other, 6);
   EXPECT_EQ(c.upper_shelf + c.holder + c.gripper + c.unknown_place, 0);
   EXPECT_EQ(truth_summary(c, 535.3),
-            "simulation truth at 535.3 s: of 10 books, 4 on the lower shelf, 0 on the upper shelf, 0 on the holder, "
-            "0 in the gripper, 6 elsewhere (taken by the librarian, or fallen off the cart)");
+            "simulation truth at 535.3 s: of 10 books, 4 on the lower shelf (4 of them standing upright), 0 on the "
+            "upper shelf, 0 on the holder, 0 in the gripper, 6 elsewhere (taken by the librarian, or fallen off the "
+            "cart)");
+}
+
+// The deployed main job of 2026-12-05 12:00 (far_cart seed 1): 8 books on the lower shelf, none standing (lying at
+// 90 deg, or at 70 deg on another). A book leaning 15 deg on its neighbour still stands.
+TEST(TruthCount, BooksOnTheLowerShelfAreCountedStandingOnlyWhenUpright) {
+  ground_truth_t gt = truth_with({"lower_shelf", "lower_shelf", "lower_shelf", "holder"});
+  auto turn = [](book_truth_t* b, double deg) {
+    b->pose.orientation[0] = std::cos(deg * M_PI / 360);
+    b->pose.orientation[2] = std::sin(deg * M_PI / 360);  // about base Y
+  };
+  turn(&gt.books[0], 90);
+  turn(&gt.books[1], 70);
+  turn(&gt.books[2], 15);
+  turn(&gt.books[3], 90);  // not on the lower shelf: not counted either way
+  EXPECT_NEAR(height_axis_tilt_deg(gt.books[1].pose), 70, 1e-9);
+  const TruthCount c = count_books_by_place(gt);
+  EXPECT_EQ(c.lower_shelf, 3);
+  EXPECT_EQ(c.lower_shelf_upright, 1);
+  EXPECT_NE(truth_summary(c, 1.0).find("3 on the lower shelf (1 of them standing upright)"), std::string::npos);
+  pose_t zero{};
+  EXPECT_TRUE(std::isnan(height_axis_tilt_deg(zero)));
 }
 
 TEST(TruthCount, APlaceItDoesNotKnowIsCountedApartAndNamed) {
