@@ -56,7 +56,8 @@ struct EvalMetrics {
   int holder_retreats = 0;                   ///< ... from which the gripper retreated
   int holder_standing = 0;                   ///< ... and that then stood on the ledge (truth)
   /// Books the truth has on the lower shelf at the end (books_moved) in scenes that checked their pose, and of them
-  /// the ones standing within kUprightMaxTiltDeg (truth_count.h) of upright (not knocked flat). Scene records before stop 31 lack both.
+  /// the ones standing within kUprightMaxTiltDeg (truth_count.h) of upright (not knocked flat). Scene records before
+  /// stop 31 lack both.
   int books_upright_checked = 0;
   int books_upright_on_lower_shelf = 0;
   int decisions = 0;                         ///< GRASP decisions with a P1

@@ -41,8 +41,9 @@ std::string truth_summary(const TruthCount& c, double message_s) {
   o.setf(std::ios::fixed);
   o.precision(1);
   o << "simulation truth at " << message_s << " s: of " << c.books << " books, " << c.lower_shelf
-    << " on the lower shelf (" << c.lower_shelf_upright << " of them standing upright), " << c.upper_shelf << " on the upper shelf, " << c.holder << " on the holder, "
-    << c.gripper << " in the gripper, " << c.other << " elsewhere (taken by the librarian, or fallen off the cart)";
+    << " on the lower shelf (" << c.lower_shelf_upright << " of them standing upright), " << c.upper_shelf
+    << " on the upper shelf, " << c.holder << " on the holder, " << c.gripper << " in the gripper, " << c.other
+    << " elsewhere (taken by the librarian, or fallen off the cart)";
   if (c.unknown_place > 0) o << ", " << c.unknown_place << " at a place this tool does not know";
   return o.str();
 }
