@@ -734,6 +734,16 @@ struct FullCycleHarness::Impl {
       int robot = c.geom1, book = c.geom2;
       if (model.geom_owner_id(book) < 0) std::swap(robot, book);
       const int b = model.geom_owner_id(book), r = model.geom_owner_id(robot);
+      // The held book touching another book off the upper shelf: placing it pushes the ones placed before.
+      if (target_book_id >= 0 && b >= 0 && r >= 0 && (b == target_book_id) != (r == target_book_id) &&
+          status.state.find("LOWER_SHELF") != std::string::npos) {
+        const int other = b == target_book_id ? r : b;
+        const std::string key = "held book " + std::to_string(target_book_id) + " book " + std::to_string(other);
+        if (touches_seen.insert(key).second)
+          trace("TOUCH_DIAG " + status.state + ": " + key + fmt(" (dist %.4f m,", c.dist) + fmt(" at %.3f", c.pos[0]) +
+                fmt(" %.3f", c.pos[1]) + fmt(" %.3f)", c.pos[2]));
+        continue;
+      }
       if (b < 0 || (r != scene::kOwnerRobotArm && r != scene::kOwnerGripperFinger)) continue;
       if (!before_grasp && b == target_book_id) continue;  // inserting, holding, placing: its own book
       const char* rn = mj_id2name(mm, mjOBJ_GEOM, robot);
