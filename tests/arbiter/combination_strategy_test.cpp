@@ -450,23 +450,22 @@ TEST(CombinationStrategy, AP2LeftOfAndBelowAnInvalidP1OnItsLeftSendsBwhToThatP1A
   CombinationTolerances off = tol;
   off.invalid_p1_over_p2 = false;
   EXPECT_EQ(combine(in, off).outcome, GraspOutcome::kGrasp);
-  // P2 at P1's book (left of PS by the lean, not below P1): grasped.
-  CombinationInputs same_book = in;
-  same_book.p2 = V(0.295, 0.088, 0.45);
-  EXPECT_EQ(combine(same_book, tol).outcome, GraspOutcome::kGrasp);
-  // P2 left of P1 but not below it by more than x (2 cm): the paper's rules.
-  CombinationInputs level = in;
-  level.p2 = V(0.285, 0.057, 0.45);
-  EXPECT_EQ(combine(level, tol).outcome, GraspOutcome::kGrasp);
-  // P2 below P1 but within y (1.5 cm) of it in Y: the paper's rules.
-  CombinationInputs near_y = in;
-  near_y.p2 = V(0.175, 0.073, 0.45);
-  EXPECT_EQ(combine(near_y, tol).outcome, GraspOutcome::kGrasp);
-  // P1 invalid on the right of PS (not a book between P2 and PS): the paper's rules.
-  CombinationInputs right = in;
-  right.p1 = V(0.30, 0.113, 0.40);
-  right.p2 = V(0.175, 0.083, 0.45);
-  EXPECT_EQ(combine(right, tol).outcome, GraspOutcome::kGrasp);
+  // Not this rule's (the paper's rules grasp): P2 at P1's book (left of PS by the lean, not below P1); P2 left of P1
+  // but not below it by more than x (2 cm); P2 below P1 but within y (1.5 cm) of it in Y; P1 invalid on the right of
+  // PS (not a book between P2 and PS).
+  const struct {
+    const char* name;
+    V p1, p2;
+  } kNotBetween[] = {{"same book", V(0.30, 0.087, 0.40), V(0.295, 0.088, 0.45)},
+                     {"level", V(0.30, 0.087, 0.40), V(0.285, 0.057, 0.45)},
+                     {"near in Y", V(0.30, 0.087, 0.40), V(0.175, 0.073, 0.45)},
+                     {"P1 right of PS", V(0.30, 0.113, 0.40), V(0.175, 0.083, 0.45)}};
+  for (const auto& k : kNotBetween) {
+    CombinationInputs c = in;
+    c.p1 = k.p1;
+    c.p2 = k.p2;
+    EXPECT_EQ(combine(c, tol).outcome, GraspOutcome::kGrasp) << k.name;
+  }
   // A valid P1 (5 mm left of PS) is not this rule's: P2 left of and below it is grasped by the paper's Y rule.
   CombinationInputs valid = in;
   valid.p1 = V(0.30, 0.095, 0.40);
@@ -491,7 +490,8 @@ TEST(CombinationStrategy, AP2LeftOfAndBelowAnInvalidP1OnItsLeftSendsBwhToThatP1A
   EXPECT_EQ(check.steps.back().rule, "P1 between P2 and PS");
   // ... but not with the rule off, nor a P1 right of PS.
   EXPECT_FALSE(validate_p1(in, off).p1_valid);
-  CombinationInputs right_between = right;
+  CombinationInputs right_between = in;
+  right_between.p1 = V(0.30, 0.113, 0.40);
   right_between.p1_between = true;
   EXPECT_FALSE(validate_p1(right_between, tol).p1_valid);
   // From P1 the tall book's corner: GP there, GP.z = P1.z.
