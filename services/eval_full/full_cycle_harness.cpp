@@ -130,6 +130,12 @@ Eigen::Isometry3d site_pose(const mjData* d, int site) {
 
 }  // namespace
 
+const book_truth_t* truth_book(const ground_truth_t& g, int id) {
+  for (const auto& b : g.books)
+    if (b.id == id) return &b;
+  return nullptr;
+}
+
 struct FullCycleHarness::Impl {
   FullCycleOptions o;
   std::chrono::steady_clock::time_point wall0 = std::chrono::steady_clock::now();
@@ -428,12 +434,6 @@ struct FullCycleHarness::Impl {
       res.books.push_back(b);
     }
     return res.books[index];
-  }
-
-  const book_truth_t* truth_book(const ground_truth_t& g, int id) const {
-    for (const auto& b : g.books)
-      if (b.id == id) return &b;
-    return nullptr;
   }
 
   /// True P1 of a book in the cart's true grasp frame (X up, Y right, Z into the shelf).

@@ -130,6 +130,9 @@ struct FullCycleResult {
   std::vector<double> plan_ms;       ///< planner wall time per PLAN_RESULT (when reported)
 };
 
+/// The book with truth id `id` in `g`, or nullptr.
+const book_truth_t* truth_book(const ground_truth_t& g, int id);
+
 /// The composed system of one scene.
 class FullCycleHarness {
  public:

@@ -39,15 +39,13 @@ std::string first_words(const std::string& msg, int words) {
 }  // namespace
 
 std::string final_place(const FullCycleResult& r, const BookRecord& b) {
-  for (const auto& t : r.final_truth.books)
-    if (t.id == b.truth_id) return t.place;
-  return "unknown";
+  const book_truth_t* t = truth_book(r.final_truth, b.truth_id);
+  return t ? t->place : "unknown";
 }
 
 double final_tilt_deg(const FullCycleResult& r, const BookRecord& b) {
-  for (const auto& t : r.final_truth.books)
-    if (t.id == b.truth_id) return height_axis_tilt_deg(t.pose);
-  return NAN;
+  const book_truth_t* t = truth_book(r.final_truth, b.truth_id);
+  return t ? height_axis_tilt_deg(t->pose) : NAN;
 }
 
 std::vector<int> untargeted_books_off_the_upper_shelf(const FullCycleResult& r) {
