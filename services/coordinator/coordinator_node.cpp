@@ -218,6 +218,15 @@ void CoordinatorNode::send(const std::vector<CycleRequest>& requests, int64_t ut
         m.num_then_poses = static_cast<int32_t>(r.then_poses.size());
         for (const Eigen::Isometry3d& p : r.then_poses)
           m.then_poses.push_back(isometry_to_pose(p, "base", "gripper", utime));
+        m.num_obstacles = static_cast<int32_t>(r.obstacles.size());
+        for (const auto& [name, box] : r.obstacles) {
+          obstacle_box_t o;
+          o.utime = utime;
+          o.name = name;
+          o.pose = isometry_to_pose(box.pose, "base", name, utime);
+          for (int i = 0; i < 3; ++i) o.size_m[i] = box.size[i];
+          m.obstacles.push_back(o);
+        }
         publish(ch_.plan_request, m);
         break;
       }

@@ -268,6 +268,15 @@ double next_lower_right_y(double right_y, double book_width, const CycleGeometry
   return right_y - (book_width + g.lower_gap);
 }
 
+OrientedBox lower_shelf_book_box(const Eigen::Isometry3d& f, double right_y, double width, double height, double depth,
+                                 const CycleGeometry& g) {
+  OrientedBox b;
+  b.pose = pose_in_grasp_frame(
+      f, Eigen::Vector3d(-g.lower_drop + height / 2, right_y - width / 2, g.lower_front_z + depth / 2));
+  b.size = Eigen::Vector3d(height, width, depth);
+  return b;
+}
+
 Eigen::Isometry3d lower_place_pose(const Eigen::Isometry3d& f, double right_y, double bw, double h,
                                    const CycleGeometry& g) {
   // The closed plates centre the book on the TCP: its right cover is BW/2 right of the TCP.

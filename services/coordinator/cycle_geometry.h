@@ -202,6 +202,16 @@ double lower_shelf_max_book_height(const CycleGeometry& g);
 /// The grasp Y of the next book's right cover on the lower shelf after a book `book_width` wide was placed with its
 /// right cover at `right_y` (`lower_gap` between them).
 double next_lower_right_y(double right_y, double book_width, const CycleGeometry& g);
+/// A box: centre and axes in some frame, full edge lengths along the axes.
+struct OrientedBox {
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();  ///< centre and axes
+  Eigen::Vector3d size = Eigen::Vector3d::Zero();          ///< full edge lengths, m
+};
+/// The volume of a book standing on the lower shelf with its right cover at grasp Y `right_y`, `width` wide and
+/// `height` tall, its fore-edge on the plane `lower_front_z` and `depth` deep into the shelf. Axes: the grasp frame's
+/// (x up: the height, y: the width, z into the cart: the depth); pose in the frame `grasp_frame` is given in (base).
+OrientedBox lower_shelf_book_box(const Eigen::Isometry3d& grasp_frame, double right_y, double width, double height,
+                                 double depth, const CycleGeometry& g);
 /// TCP pose that stands the held book on the lower shelf with its right cover at grasp Y `right_y`.
 Eigen::Isometry3d lower_place_pose(const Eigen::Isometry3d& grasp_frame, double right_y, double book_width,
                                    double tcp_height, const CycleGeometry& g);

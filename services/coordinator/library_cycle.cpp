@@ -175,6 +175,7 @@ CycleSettings CycleSettings::from_config(const Config& root) {
   s.plan_position_tolerance_m = p.get_double("position_tolerance_m", 1e-5, 0.1);
   s.plan_orientation_tolerance_rad = p.get_double("orientation_tolerance_rad", 1e-5, 1.0);
   s.held_book_depth_m = p.get_double("held_book_depth_m", 0.01, 1.0);
+  s.placed_books_as_obstacles = p.get<bool>("placed_books_as_obstacles");
   const Config a = root.child("arm");
   s.heartbeat_period_s = a.get_double("heartbeat_period_s", 0.005, 0.1);
   s.linear_max_speed = a.get_double("linear_max_speed_mps", 0.001, 0.15);
@@ -252,6 +253,21 @@ Eigen::Isometry3d LibraryCycle::cart_frame() const {
 Eigen::Isometry3d LibraryCycle::holder_frame() const {
   return holder_support_frame(*holder_marker_, s_.geometry);
 }
+std::vector<std::pair<std::string, OrientedBox>> LibraryCycle::placed_book_obstacles() const {
+  std::vector<std::pair<std::string, OrientedBox>> boxes;
+  if (!s_.placed_books_as_obstacles) return boxes;
+  const CycleGeometry& g = s_.geometry;
+  for (const MovedBook& b : progress_.moved) {
+    if (b.handed_over || !std::isfinite(b.lower_right_y)) continue;
+    // A progress file from before the height was kept: as tall as the lower shelf takes (none if it takes any).
+    const double height = std::isfinite(b.height) && b.height > 0 ? b.height : lower_shelf_max_book_height(g);
+    if (!std::isfinite(height)) continue;
+    boxes.emplace_back("lower_shelf_book_" + std::to_string(b.index),
+                       lower_shelf_book_box(cart_frame(), b.lower_right_y, b.width, height, s_.held_book_depth_m, g));
+  }
+  return boxes;
+}
+
 double LibraryCycle::held_box_height() const {
   return std::max(0.0, progress_.gp_grasp.x());
 }
@@ -342,6 +358,7 @@ void LibraryCycle::issue_plan() {
   r.holding_book = motion_.holding;
   r.then_poses = motion_.then;
   if (motion_.holding) r.book_size = Eigen::Vector3d(progress_.book_width, held_box_height(), s_.held_book_depth_m);
+  r.obstacles = placed_book_obstacles();
   out_.push_back(r);
 }
 
@@ -633,6 +650,7 @@ void LibraryCycle::book_done(bool handed_over) {
   b.gp_y = progress_.gp_grasp.y();
   b.lower_right_y = handed_over ? std::numeric_limits<double>::quiet_NaN() : progress_.lower_next_right_y;
   b.handed_over = handed_over;
+  b.height = progress_.gp_grasp.x();
   progress_.moved.push_back(b);
   progress_.books_moved += 1;
   if (!handed_over)

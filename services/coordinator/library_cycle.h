@@ -31,6 +31,7 @@
 #include <limits>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Geometry>
@@ -66,6 +67,9 @@ struct CycleSettings {
   double plan_position_tolerance_m = 0.002;
   double plan_orientation_tolerance_rad = 0.02;
   double held_book_depth_m = 0.25;  ///< depth assumed for a held book (collision model)
+  /// Not in the paper: every plan carries the books placed on the lower shelf as boxes (`held_book_depth_m` deep),
+  /// so a planned move does not sweep the arm or the held book through them.
+  bool placed_books_as_obstacles = true;
   // arm commands
   double heartbeat_period_s = 0.05;       ///< <= 0.1 s: the driver stops after 0.5 s without
   double linear_max_speed = 0.05;         ///< m/s for straight moves
@@ -182,6 +186,8 @@ struct CycleRequest {
   bool holding_book = false;
   Eigen::Vector3d book_size = Eigen::Vector3d::Zero();  ///< width, height, depth
   std::vector<Eigen::Isometry3d> then_poses;            ///< kPlan, pose goal: the straight moves after it (base)
+  /// kPlan: boxes in base the planner avoids for this plan (the books placed on the lower shelf), with their names.
+  std::vector<std::pair<std::string, OrientedBox>> obstacles;
   int64_t plan_id = 0;
   Eigen::Matrix<double, 6, 1> twist = Eigen::Matrix<double, 6, 1>::Zero();
   double width = 0;
@@ -335,6 +341,8 @@ class LibraryCycle {
   void persist();
   int64_t next_id();
   Eigen::Isometry3d cart_frame() const;
+  /// The books on the lower shelf as boxes in base (`placed_books_as_obstacles`), named "lower_shelf_book_<index>".
+  std::vector<std::pair<std::string, OrientedBox>> placed_book_obstacles() const;
   Eigen::Isometry3d holder_frame() const;
   double tcp_height() const;
   /// TCP height above the held book's bottom for the holder's place poses: tcp_height() for a book from the upper

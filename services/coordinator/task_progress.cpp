@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <cstring>
 #include <fstream>
+#include <limits>
 #include <sstream>
 #include <stdexcept>
 
@@ -63,7 +64,8 @@ std::string progress_to_yaml(const TaskProgress& p) {
   for (const MovedBook& b : p.moved)
     e << YAML::Flow << YAML::BeginMap << YAML::Key << "index" << YAML::Value << b.index << YAML::Key << "width"
       << YAML::Value << b.width << YAML::Key << "gp_y" << YAML::Value << b.gp_y << YAML::Key << "lower_right_y"
-      << YAML::Value << b.lower_right_y << YAML::Key << "handed_over" << YAML::Value << b.handed_over << YAML::EndMap;
+      << YAML::Value << b.lower_right_y << YAML::Key << "handed_over" << YAML::Value << b.handed_over << YAML::Key
+      << "height" << YAML::Value << b.height << YAML::EndMap;
   e << YAML::EndSeq << YAML::EndMap;
   return std::string(e.c_str()) + "\n";
 }
@@ -99,6 +101,7 @@ TaskProgress progress_from_yaml(const std::string& text, const std::string& sour
     m.gp_y = need<double>(b, "gp_y", source);
     m.lower_right_y = need<double>(b, "lower_right_y", source);
     m.handed_over = b["handed_over"] ? need<bool>(b, "handed_over", source) : false;  // absent before stop 22
+    m.height = b["height"] ? need<double>(b, "height", source) : std::numeric_limits<double>::quiet_NaN();  // stop 32
     p.moved.push_back(m);
   }
   if (p.books_moved < 0 || p.books_moved != static_cast<int>(p.moved.size()))

@@ -6,6 +6,7 @@
 /// about it, and the next free slot on the lower shelf. Written atomically
 /// (temporary file, fsync, rename). No LCM.
 
+#include <limits>
 #include <optional>
 #include <string>
 #include <vector>
@@ -34,6 +35,9 @@ struct MovedBook {
   /// Too tall for, or not placeable on, the lower shelf: left on the holder and taken off it by the librarian
   /// (WAIT_BOOK_TAKEN).
   bool handed_over = false;
+  /// Its height (GP.x: the top's height over the shelf it was taken from), m; NaN in progress files written before
+  /// stop 32 (then the placed book's box for the planner is as tall as the lower shelf takes).
+  double height = std::numeric_limits<double>::quiet_NaN();
 };
 
 /// Everything persisted.

@@ -14,6 +14,8 @@ uint64_t mix_seed(uint64_t x) {  // splitmix64: request identity -> planner seed
   return x ^ (x >> 31);
 }
 
+constexpr double kMaxObstacleSizeM = 2.0;  // a request's box larger than this is a mistake (the cart is 0.84 m wide)
+
 bool all_finite(const std::vector<double>& v) {
   for (double x : v)
     if (!std::isfinite(x)) return false;
@@ -102,6 +104,21 @@ plan_result_t PlannerNode::process(const plan_request_t& req) const {
       return invalid("then_poses[" + std::to_string(i) + "] is in frame '" + req.then_poses[i].frame +
                      "'; give it in 'base'");
   }
+  if (req.num_obstacles < 0 || static_cast<size_t>(req.num_obstacles) != req.obstacles.size())
+    return invalid("num_obstacles " + std::to_string(req.num_obstacles) + " differs from obstacles' length");
+  std::vector<SceneBox> obstacles;
+  for (size_t i = 0; i < req.obstacles.size(); ++i) {
+    const obstacle_box_t& b = req.obstacles[i];
+    const std::string which = "obstacles[" + std::to_string(i) + "] ('" + b.name + "')";
+    if (!is_valid_pose(b.pose)) return invalid(which + " pose is not a rigid transform (NaN or non-unit quaternion)");
+    if (!b.pose.frame.empty() && b.pose.frame != "base")
+      return invalid(which + " is in frame '" + b.pose.frame + "'; give it in 'base'");
+    for (double s : b.size_m)
+      if (!std::isfinite(s) || s <= 0 || s > kMaxObstacleSizeM)
+        return invalid(which + " size_m must be three sizes in (0, " + std::to_string(kMaxObstacleSizeM) + "] m");
+    obstacles.push_back(SceneBox{"request_" + b.name, pose_to_isometry(b.pose),
+                                 Eigen::Vector3d(b.size_m[0], b.size_m[1], b.size_m[2])});
+  }
   if (!std::isfinite(req.time_budget_s) || req.time_budget_s < 0) return invalid("time_budget_s must be >= 0 (0 = default)");
   if (req.time_budget_s > settings_.max_time_budget_s)
     return invalid("time_budget_s " + std::to_string(req.time_budget_s) + " exceeds planner.max_time_budget_s " +
@@ -129,6 +146,11 @@ plan_result_t PlannerNode::process(const plan_request_t& req) const {
   r.planner = req.planner;
   r.seed = mix_seed(static_cast<uint64_t>(req.utime) ^ mix_seed(static_cast<uint64_t>(req.request_id)) ^ settings_.ik.seed);
   PlanningScene scene = scene_;
+  if (!obstacles.empty()) {
+    std::vector<SceneBox> environment = scene.environment();
+    environment.insert(environment.end(), obstacles.begin(), obstacles.end());
+    scene.set_environment(std::move(environment));
+  }
   if (req.holding_book)
     scene.attach(held_book_box(Eigen::Vector3d(req.held_book_size_m[0], req.held_book_size_m[1], req.held_book_size_m[2]),
                                settings_.held_book));

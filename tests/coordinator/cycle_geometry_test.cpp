@@ -247,6 +247,24 @@ TEST(CycleGeometry, TheNextLowerShelfSlotIsLeftOfTheBookAndTheGap) {
   EXPECT_NEAR(next_lower_right_y(0.10, 0.02, g), 0.077, 1e-12);  // grasp Y grows to the right
 }
 
+// A 20 mm book 0.25 m tall with its right cover at grasp Y 0.10 on the default cart (origin (0.6, -0.05, 0)): it
+// stands on the lower shelf (grasp X -0.32 .. -0.07), covers Y 0.08 .. 0.10, fore-edge on Z -0.03, 0.30 deep.
+TEST(CycleGeometry, ABookOnTheLowerShelfIsABoxFromItsCoversShelfAndForeEdge) {
+  const CycleGeometry g = geometry();
+  Eigen::Isometry3d f = Eigen::Isometry3d::Identity();
+  f.linear() = grasp_axes();
+  f.translation() = Eigen::Vector3d(0.6, -0.05, 0.0);
+  const OrientedBox b = lower_shelf_book_box(f, 0.10, 0.02, 0.25, 0.30, g);
+  // Centre in grasp (-0.195, 0.09, 0.12) -> base (0.6 + 0.12, -0.05 - 0.09, -0.195).
+  EXPECT_TRUE(b.pose.translation().isApprox(Eigen::Vector3d(0.72, -0.14, -0.195), 1e-12)) << b.pose.translation();
+  EXPECT_TRUE(b.pose.linear().isApprox(grasp_axes(), 1e-12));
+  EXPECT_TRUE(b.size.isApprox(Eigen::Vector3d(0.25, 0.02, 0.30), 1e-12)) << b.size;
+  // Its right cover is where the place pose puts the held book's: TCP Y - BW / 2 ... the box's Y extent.
+  const Eigen::Vector3d tcp = f.inverse() * lower_place_pose(f, 0.10, 0.02, 0.24, g).translation();
+  const Eigen::Vector3d centre = f.inverse() * b.pose.translation();
+  EXPECT_NEAR(tcp.y(), centre.y(), 1e-12);
+}
+
 TEST(CycleGeometry, TheReleaseOnTheLowerShelfOpensThePlatesOnlyAFewMillimetresOverTheBook) {
   CycleGeometry g = geometry();
   g.lower_release_opening = 0.006;

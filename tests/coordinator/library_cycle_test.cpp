@@ -145,8 +145,8 @@ TEST(LibraryCycle, ThreeBooksWholeCycleEveryTransitionAndPlacements) {
   EXPECT_EQ(cycle.status().state, "DONE");
   EXPECT_EQ(cycle.status().books_moved, 3);
 
-  // Lower shelf (coordinator.yaml lower_shelf: first_right_y 0.10, gap 0.005, front_z -0.04, drop 0.32): right covers
-  // at 0.10, 0.10 - 0.025 - 0.005 = 0.07, 0.07 - 0.020 - 0.005 = 0.045; TCP Y = right - BW/2;
+  // Lower shelf (coordinator.yaml lower_shelf: first_right_y 0.10, gap 0.018, front_z -0.04, drop 0.32): right covers
+  // at 0.10, 0.10 - 0.025 - 0.018 = 0.057, 0.057 - 0.020 - 0.018 = 0.019; TCP Y = right - BW/2;
   // Z = -0.04 + 0.03 (insertion) = -0.01. Base = (0.60 + Z, -0.05 - Y, X). X: the book was taken from the holder
   // with the TCP holder.regrasp_lower_m (0.015) lower than at its release, after it had dropped place_clearance_m
   // (0.005) onto the ledge, so the TCP is height - 0.015 + 0.005 above its bottom; the place leaves 0.005 below it:
@@ -154,7 +154,7 @@ TEST(LibraryCycle, ThreeBooksWholeCycleEveryTransitionAndPlacements) {
   // shelf: its top (P1.x) plus grasp.offset_x_m (shipped -0.012: 12 mm below the top).
   const double gx = settings().geometry.grasp_offset_x;
   ASSERT_NEAR(gx, -0.012, 1e-12);
-  const double ys[3] = {0.10 - 0.0125, 0.07 - 0.010, 0.045 - 0.015};
+  const double ys[3] = {0.10 - 0.0125, 0.057 - 0.010, 0.019 - 0.015};
   const double hs[3] = {0.25 + gx, 0.18 + gx, 0.22 + gx};
   for (int i = 0; i < 3; ++i) {
     const Eigen::Vector3d tcp = w.lower[i].second.translation();
@@ -162,25 +162,25 @@ TEST(LibraryCycle, ThreeBooksWholeCycleEveryTransitionAndPlacements) {
     EXPECT_NEAR(tcp.y(), -0.05 - ys[i], 0.0015) << "book " << i;
     EXPECT_NEAR(tcp.z(), -0.32 + hs[i] - 0.015 + 0.005 + 0.005, 0.0015) << "book " << i;
   }
-  // The releases on the lower shelf open the plates fully (lower_shelf.release_opening_m 0); with 6 mm, to the book
-  // + 6 mm: 31, 26 and 36 mm for the 25, 20 and 30 mm books (the gap then at least a plate + 3 mm).
+  // The releases on the lower shelf open the plates to the book + 6 mm (lower_shelf.release_opening_m): 31, 26 and
+  // 36 mm for the 25, 20 and 30 mm books (the 18 mm gap leaves a plate + 5 mm); with 0, fully.
   const auto release_opens = [](const FakeLibrary& f) {
     std::vector<double> v;
     for (const CycleRequest& r : f.requests)
       if (r.kind == CycleRequest::Kind::kGripperMove && r.width < 0.04) v.push_back(r.width);
     return v;
   };
-  EXPECT_TRUE(release_opens(w).empty());
   {
-    CycleSettings narrow = settings();
-    narrow.geometry.lower_release_opening = 0.006;
-    FakeLibrary wn(three_books());
-    LibraryCycle cn(narrow, std::nullopt);
-    wn.run(cn, [&] { return done_or_aborted(cn); });
-    ASSERT_EQ(cn.state(), CycleState::kDone) << cn.status().message;
-    const std::vector<double> opens = release_opens(wn);
+    const std::vector<double> opens = release_opens(w);
     ASSERT_EQ(opens.size(), 3u);
     for (int i = 0; i < 3; ++i) EXPECT_NEAR(opens[i], (std::vector<double>{0.031, 0.026, 0.036})[i], 1e-9);
+    CycleSettings full = settings();
+    full.geometry.lower_release_opening = 0.0;
+    FakeLibrary wf(three_books());
+    LibraryCycle cf(full, std::nullopt);
+    wf.run(cf, [&] { return done_or_aborted(cf); });
+    ASSERT_EQ(cf.state(), CycleState::kDone) << cf.status().message;
+    EXPECT_TRUE(release_opens(wf).empty());
   }
   // The grasp from the holder: over the place in x and y, 0.015 lower (the TCP at release was height + 0.005 above
   // the ledge, support z = base z, ledge at -0.09).
@@ -256,6 +256,68 @@ TEST(LibraryCycle, ThreeBooksWholeCycleEveryTransitionAndPlacements) {
     }
   }
   EXPECT_GT(heartbeats, 0);
+}
+
+// Not in the paper: once a book stands on the lower shelf, every plan carries it as a box, so the planner keeps the
+// arm and the next held book clear of it. Boxes by hand (coordinator.yaml; the fake's cart: base = (0.60 + Z,
+// -0.05 - Y, X) of the grasp frame): right covers 0.10, 0.057, 0.019 (gap 0.018), on the lower shelf at X -0.32 as
+// tall as the book (its P1.x), fore-edge on Z -0.04 and planning.held_book_depth_m (0.30) deep.
+TEST(LibraryCycle, EveryPlanAfterABookStandsOnTheLowerShelfCarriesItAsABox) {
+  const auto plans_obstacles = [](const FakeLibrary& f) {
+    std::vector<std::vector<std::pair<std::string, bookgrasp::OrientedBox>>> v;
+    for (const CycleRequest& r : f.requests)
+      if (r.kind == CycleRequest::Kind::kPlan) v.push_back(r.obstacles);
+    return v;
+  };
+  FakeLibrary w(three_books());
+  LibraryCycle cycle(settings(), std::nullopt);
+  w.run(cycle, [&] { return done_or_aborted(cycle); });
+  ASSERT_EQ(cycle.state(), CycleState::kDone) << cycle.status().message;
+  const auto plans = plans_obstacles(w);
+  ASSERT_GE(plans.size(), 10u);
+  EXPECT_TRUE(plans.front().empty());
+  EXPECT_EQ(plans.back().size(), 3u) << "the plans after the third book's place";
+  const double right[3] = {0.10, 0.057, 0.019}, width[3] = {0.025, 0.020, 0.030}, height[3] = {0.25, 0.18, 0.22};
+  size_t before = 0;
+  for (const auto& boxes : plans) {
+    EXPECT_GE(boxes.size(), before) << "a placed book left the planner's world";
+    before = boxes.size();
+    for (size_t i = 0; i < boxes.size(); ++i) {
+      EXPECT_EQ(boxes[i].first, "lower_shelf_book_" + std::to_string(i));
+      const Eigen::Vector3d c(0.60 + (-0.04 + 0.15), -0.05 - (right[i] - width[i] / 2), -0.32 + height[i] / 2);
+      EXPECT_TRUE(boxes[i].second.pose.translation().isApprox(c, 1e-9))
+          << "book " << i << ": " << boxes[i].second.pose.translation().transpose();
+      EXPECT_TRUE(boxes[i].second.size.isApprox(Eigen::Vector3d(height[i], width[i], 0.30), 1e-9)) << "book " << i;
+    }
+  }
+  for (int i = 0; i < 3; ++i) EXPECT_NEAR(cycle.progress().moved[i].height, height[i], 1e-9);
+
+  // Off: no boxes.
+  CycleSettings off = settings();
+  off.placed_books_as_obstacles = false;
+  FakeLibrary wo(three_books());
+  LibraryCycle co(off, std::nullopt);
+  wo.run(co, [&] { return done_or_aborted(co); });
+  ASSERT_EQ(co.state(), CycleState::kDone) << co.status().message;
+  for (const auto& boxes : plans_obstacles(wo)) EXPECT_TRUE(boxes.empty());
+
+  // Resumed from a progress file written before the height was kept: the box is as tall as the lower shelf takes
+  // (0.30 - 2 x 0.013 = 0.274 m); a book handed to the librarian is no box.
+  bookgrasp::TaskProgress old;
+  old.books_moved = 2;
+  old.moved.push_back({0, 0.025, 0.30, 0.10});
+  old.moved.push_back({1, 0.020, 0.27, std::numeric_limits<double>::quiet_NaN(), true});
+  old.gp_grasp = Eigen::Vector3d(0.0, 0.0, 0.0);
+  old.lower_next_right_y = 0.057;
+  FakeLibrary wr({three_books()[2]});
+  LibraryCycle resumed(settings(), old);
+  wr.run(resumed, [&] { return !plans_obstacles(wr).empty() || done_or_aborted(resumed); });
+  const auto first = plans_obstacles(wr);
+  ASSERT_FALSE(first.empty()) << resumed.status().message;
+  ASSERT_EQ(first.front().size(), 1u);
+  EXPECT_EQ(first.front()[0].first, "lower_shelf_book_0");
+  EXPECT_NEAR(first.front()[0].second.size.x(), 0.274, 1e-9);
+  EXPECT_NEAR(first.front()[0].second.pose.translation().z(), -0.32 + 0.274 / 2, 1e-9);
 }
 
 // Not in the paper: a book taller than the lower shelf takes (coordinator.yaml: 0.30 - 2 x 0.013 = 0.274 m) is not
@@ -546,9 +608,10 @@ TEST(LibraryCycle, BadDepthKeysNameTheKey) {
         {"grasp.more_than_the_book_m", "more_than_the_book_m: 0.0025", "more_than_the_book_m: 0.2"},
         {"grasp.width_left_clearance_m", "width_left_clearance_m: 0.005", "width_left_clearance_m: 0.2"},
         {"holder.regrasp_min_height_m", "regrasp_min_height_m: 0.15", "regrasp_min_height_m: -0.1"},
-        {"lower_shelf.release_opening_m", "release_opening_m: 0.0 ", "release_opening_m: 0.1 "},
-        // A 6 mm release opening with the 5 mm gap: the right plate would push the book placed before over.
-        {"lower_shelf.gap_m", "release_opening_m: 0.0 ", "release_opening_m: 0.006 "}}) {
+        {"lower_shelf.release_opening_m", "release_opening_m: 0.006 ", "release_opening_m: 0.1 "},
+        // The 6 mm release opening with a 5 mm gap: the right plate would push the book placed before over.
+        {"lower_shelf.gap_m", "gap_m: 0.018 ", "gap_m: 0.005 "},
+        {"planning.placed_books_as_obstacles", "placed_books_as_obstacles: true", "placed_books_as_obstacles: 0.3"}}) {
     std::string text = shipped;
     const auto pos = text.find(line);
     ASSERT_NE(pos, std::string::npos) << line;
@@ -1131,7 +1194,7 @@ TEST(TaskProgress, RoundTripAndCorruptFilesAreNamed) {
   p.lower_next_right_y = 0.34;
   p.last_state = "WAIT_USER";
   p.hand_over_reason = "MOVE_TO_LOWER_SHELF failed 3 times";
-  p.moved.push_back({0, 0.02, 0.31, 0.37});
+  p.moved.push_back({0, 0.02, 0.31, 0.37, false, 0.245});
   p.moved.push_back({1, 0.03, 0.28, std::numeric_limits<double>::quiet_NaN(), true});  // handed over
   p.books_moved = 2;
   const auto q = bookgrasp::progress_from_yaml(bookgrasp::progress_to_yaml(p), "test");
@@ -1148,6 +1211,8 @@ TEST(TaskProgress, RoundTripAndCorruptFilesAreNamed) {
       "old.yaml");
   ASSERT_EQ(old.moved.size(), 1u);
   EXPECT_FALSE(old.moved[0].handed_over);
+  EXPECT_TRUE(std::isnan(old.moved[0].height)) << "a file from before stop 32 has no height";
+  EXPECT_EQ(q.moved[0].height, 0.245);
   EXPECT_TRUE(old.hand_over_reason.empty());
   EXPECT_EQ(q.hand_over_reason, "MOVE_TO_LOWER_SHELF failed 3 times");
   EXPECT_EQ(q.place, BookPlace::kOnHolder);

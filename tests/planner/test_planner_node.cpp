@@ -29,6 +29,7 @@ plan_request_t joint_request(const std::vector<double>& start, const std::vector
   r.holding_book = false;
   r.held_book_size_m[0] = r.held_book_size_m[1] = r.held_book_size_m[2] = 0.0;
   r.num_then_poses = 0;
+  r.num_obstacles = 0;
   return r;
 }
 
@@ -137,6 +138,84 @@ TEST_F(PlannerNodeTest, BadRequestsAreAnsweredWithReasons) {
   out = node_.process(r);
   EXPECT_EQ(out.failure, plan_result_t::INVALID_REQUEST);
   EXPECT_NE(out.message.find("'cart'"), std::string::npos) << out.message;
+}
+
+TEST_F(PlannerNodeTest, BadObstaclesAreAnsweredNamingTheBox) {
+  const auto box = [](const std::string& name) {
+    obstacle_box_t b;
+    b.name = name;
+    b.pose = isometry_to_pose(Eigen::Isometry3d::Identity(), "base", name, 0);
+    b.size_m[0] = b.size_m[1] = b.size_m[2] = 0.05;
+    return b;
+  };
+  plan_request_t r = joint_request(kHome, kUp);
+  r.num_obstacles = 1;  // no box given
+  plan_result_t out = node_.process(r);
+  EXPECT_EQ(out.failure, plan_result_t::INVALID_REQUEST);
+  EXPECT_NE(out.message.find("num_obstacles"), std::string::npos) << out.message;
+  r.obstacles.push_back(box("book_0"));
+  r.obstacles[0].pose.position[2] = NAN;
+  out = node_.process(r);
+  EXPECT_EQ(out.failure, plan_result_t::INVALID_REQUEST);
+  EXPECT_NE(out.message.find("obstacles[0] ('book_0') pose"), std::string::npos) << out.message;
+  r.obstacles[0] = box("book_0");
+  r.obstacles[0].pose.frame = "cart";
+  out = node_.process(r);
+  EXPECT_EQ(out.failure, plan_result_t::INVALID_REQUEST);
+  EXPECT_NE(out.message.find("'cart'"), std::string::npos) << out.message;
+  for (const double bad : {0.0, -0.1, 5.0, double(NAN)}) {
+    r.obstacles[0] = box("book_0");
+    r.obstacles[0].size_m[1] = bad;
+    out = node_.process(r);
+    EXPECT_EQ(out.failure, plan_result_t::INVALID_REQUEST) << bad;
+    EXPECT_NE(out.message.find("obstacles[0] ('book_0') size_m"), std::string::npos) << out.message;
+  }
+}
+
+// A request's boxes are in the environment for that request: a goal inside one is refused naming it, a path past one
+// goes around it (checked on the exact shapes at every trajectory sample), and the next request no longer has them.
+TEST_F(PlannerNodeTest, RequestObstaclesAreAvoidedForThatRequestOnly) {
+  const PlannerStack stack(node_.settings());
+  const Eigen::Map<const Eigen::VectorXd> home(kHome.data(), 7), up(kUp.data(), 7);
+  const auto obstacle_at = [](const Eigen::Vector3d& centre, double edge) {
+    obstacle_box_t b;
+    b.name = "placed_book_0";
+    Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+    pose.translation() = centre;
+    b.pose = isometry_to_pose(pose, "base", "placed_book_0", 0);
+    b.size_m[0] = b.size_m[1] = b.size_m[2] = edge;
+    return b;
+  };
+  // 1. A box around the goal's TCP: the goal is in collision with it.
+  plan_request_t r = joint_request(kHome, kUp);
+  r.obstacles.push_back(obstacle_at(stack.kinematics.tip_pose(up).translation(), 0.06));
+  r.num_obstacles = 1;
+  plan_result_t out = node_.process(r);
+  EXPECT_FALSE(out.success);
+  EXPECT_EQ(out.failure, plan_result_t::GOAL_IN_COLLISION) << out.message;
+  EXPECT_NE(out.message.find("request_placed_book_0"), std::string::npos) << out.message;
+
+  // 2. A box where the straight joint-space move passes the TCP halfway: the plan goes around it.
+  const Eigen::VectorXd middle = 0.5 * (home + up);
+  r.obstacles[0] = obstacle_at(stack.kinematics.tip_pose(middle).translation(), 0.10);
+  PlanningScene with_box = stack.scene;
+  std::vector<SceneBox> env = with_box.environment();
+  const obstacle_box_t& b = r.obstacles[0];
+  env.push_back(SceneBox{"box", pose_to_isometry(b.pose), Eigen::Vector3d(b.size_m[0], b.size_m[1], b.size_m[2])});
+  with_box.set_environment(env);
+  ASSERT_TRUE(with_box.is_valid(home));
+  ASSERT_TRUE(with_box.is_valid(up));
+  ASSERT_TRUE(with_box.check(middle, false).collision) << "the straight move must pass through the box";
+  out = node_.process(r);
+  ASSERT_TRUE(out.success) << out.message;
+  for (const auto& p : out.trajectory.points) {
+    const Eigen::Map<const Eigen::VectorXd> q(p.positions.data(), 7);
+    const CollisionReport c = with_box.check(q, false);
+    EXPECT_FALSE(c.collision) << c.describe() << " at t = " << p.utime * 1e-6 << " s";
+  }
+
+  // 3. The next request without boxes: the goal of 1. is free again.
+  EXPECT_TRUE(node_.process(joint_request(kHome, kUp)).success);
 }
 
 TEST_F(PlannerNodeTest, CartMarkerMovesTheCartBoxes) {
