@@ -2,12 +2,9 @@
 // coordinator placed on the lower shelf, for the planner to avoid). The PLAN_REQUEST events of logs/samples/ are
 // re-encoded in the new type with no obstacles (what the coordinator sends before the first book is on the lower
 // shelf); every other byte of the log is kept. Build by hand, see logs/README.md.
-#include <cstdio>
-#include <lcm/lcm-cpp.hpp>
-#include <vector>
-
 #include "bookgrasp/plan_request_t.hpp"
 #include "bookgrasp_old/plan_request_t.hpp"
+#include "log_migration.h"
 
 namespace {
 
@@ -24,44 +21,28 @@ bookgrasp::pose_t convert(const bookgrasp_old::pose_t& o) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  if (argc != 3) {
-    std::fprintf(stderr, "usage: %s IN.lcm OUT.lcm\n", argv[0]);
-    return 2;
-  }
-  lcm::LogFile in(argv[1], "r"), out(argv[2], "w");
-  int n = 0, conv = 0;
-  std::vector<unsigned char> buf;
-  while (const lcm::LogEvent* e = in.readNextEvent()) {
-    lcm::LogEvent ev = *e;
-    bookgrasp_old::plan_request_t o;
-    if (o.decode(e->data, 0, e->datalen) == e->datalen) {
-      bookgrasp::plan_request_t m;
-      m.utime = o.utime;
-      m.request_id = o.request_id;
-      m.planner = o.planner;
-      m.goal_type = o.goal_type;
-      m.num_joints = o.num_joints;
-      m.start_joints = o.start_joints;
-      m.goal_joints = o.goal_joints;
-      m.goal_pose = convert(o.goal_pose);
-      m.position_tolerance_m = o.position_tolerance_m;
-      m.orientation_tolerance_rad = o.orientation_tolerance_rad;
-      m.keep_orientation = o.keep_orientation;
-      m.time_budget_s = o.time_budget_s;
-      m.holding_book = o.holding_book;
-      for (int i = 0; i < 3; ++i) m.held_book_size_m[i] = o.held_book_size_m[i];
-      m.num_then_poses = o.num_then_poses;
-      for (const auto& p : o.then_poses) m.then_poses.push_back(convert(p));
-      m.num_obstacles = 0;
-      buf.resize(m.getEncodedSize());
-      m.encode(buf.data(), 0, buf.size());
-      ev.data = buf.data();
-      ev.datalen = buf.size();
-      ++conv;
-    }
-    out.writeEvent(&ev);
-    ++n;
-  }
-  std::printf("%d events, %d plan_request_t converted\n", n, conv);
-  return 0;
+  return migrate_log<bookgrasp_old::plan_request_t>(argc, argv, "plan_request_t",
+                                                    [](const bookgrasp_old::plan_request_t& o) {
+                                                      bookgrasp::plan_request_t m;
+                                                      m.utime = o.utime;
+                                                      m.request_id = o.request_id;
+                                                      m.planner = o.planner;
+                                                      m.goal_type = o.goal_type;
+                                                      m.num_joints = o.num_joints;
+                                                      m.start_joints = o.start_joints;
+                                                      m.goal_joints = o.goal_joints;
+                                                      m.goal_pose = convert(o.goal_pose);
+                                                      m.position_tolerance_m = o.position_tolerance_m;
+                                                      m.orientation_tolerance_rad = o.orientation_tolerance_rad;
+                                                      m.keep_orientation = o.keep_orientation;
+                                                      m.time_budget_s = o.time_budget_s;
+                                                      m.holding_book = o.holding_book;
+                                                      for (int i = 0; i < 3; ++i)
+                                                        m.held_book_size_m[i] = o.held_book_size_m[i];
+                                                      m.num_then_poses = o.num_then_poses;
+                                                      for (const auto& p : o.then_poses)
+                                                        m.then_poses.push_back(convert(p));
+                                                      m.num_obstacles = 0;
+                                                      return m;
+                                                    });
 }

@@ -1,11 +1,8 @@
 // Shared by the one-off servo_status_t migrations of logs/samples/ (see logs/README.md): every event is copied byte
 // for byte except the SERVO_STATUS ones, which are re-encoded in the new type.
 #pragma once
-#include <cstdio>
-#include <lcm/lcm-cpp.hpp>
-#include <vector>
-
 #include "bookgrasp/servo_status_t.hpp"
+#include "log_migration.h"
 
 /// Copies the fields every servo_status_t version has had since the triangulated corner (stop 20).
 template <class Old>
@@ -33,29 +30,10 @@ void copy_common_fields(const Old& o, bookgrasp::servo_status_t* m) {
 /// copied and `set_new_fields(old, &new)` applied. Prints the counts.
 template <class Old, class SetNewFields>
 int migrate_servo_status(int argc, char** argv, SetNewFields set_new_fields) {
-  if (argc != 3) {
-    std::fprintf(stderr, "usage: %s IN.lcm OUT.lcm\n", argv[0]);
-    return 2;
-  }
-  lcm::LogFile in(argv[1], "r"), out(argv[2], "w");
-  int n = 0, conv = 0;
-  std::vector<unsigned char> buf;
-  while (const lcm::LogEvent* e = in.readNextEvent()) {
-    lcm::LogEvent ev = *e;
-    Old o;
-    if (o.decode(e->data, 0, e->datalen) == e->datalen) {
-      bookgrasp::servo_status_t m{};
-      copy_common_fields(o, &m);
-      set_new_fields(o, &m);
-      buf.resize(m.getEncodedSize());
-      m.encode(buf.data(), 0, buf.size());
-      ev.data = buf.data();
-      ev.datalen = buf.size();
-      ++conv;
-    }
-    out.writeEvent(&ev);
-    ++n;
-  }
-  std::printf("%d events, %d servo_status_t converted\n", n, conv);
-  return 0;
+  return migrate_log<Old>(argc, argv, "servo_status_t", [&](const Old& o) {
+    bookgrasp::servo_status_t m{};
+    copy_common_fields(o, &m);
+    set_new_fields(o, &m);
+    return m;
+  });
 }
