@@ -34,6 +34,7 @@
 #include "common/service_host.h"
 #include "services/eval_full/component_factories.h"
 #include "services/sim_world/sim_world_node.h"
+#include "services/task_watch/truth_count.h"
 
 namespace bookgrasp {
 
@@ -463,6 +464,18 @@ struct FullCycleHarness::Impl {
     trace("TASK_STATUS " + prev + " -> " + m->state + " (book " + std::to_string(m->current_book) + ", attempt " +
           std::to_string(m->attempt) + ", moved " + std::to_string(m->books_moved) + ") " + m->message);
     const ground_truth_t now_truth = sim->world().model().ground_truth(sim->world().now_utime());
+    // The books on the lower shelf and how far each leans: as a book arrives (a move that swept into one shows
+    // here), after each release and retreat, and at the end.
+    if (o.verbose &&
+        (m->state == "PLACE_ON_LOWER_SHELF" || (prev == "RETREAT_FROM_LOWER_SHELF" && m->state == "PARK") ||
+         m->state == "DONE" || m->state == "ABORTED")) {
+      std::string l = "TRUTH lower shelf (book id: tilt, base y):";
+      for (const auto& tb : now_truth.books)
+        if (tb.place == "lower_shelf")
+          l += " " + std::to_string(tb.id) + fmt(": %.1f deg", height_axis_tilt_deg(tb.pose)) +
+               fmt(" %.0f mm,", tb.pose.position[1] * 1e3);
+      trace(l);
+    }
     if (m->state == "WAIT_P1_CHECK" || m->state == "MOVE_TO_STRIPE_START" || m->state == "MOVE_TO_BWH_START") {
       BookRecord& b = book(m->current_book);
       if (b.truth_id < 0) {
