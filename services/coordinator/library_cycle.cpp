@@ -176,6 +176,7 @@ CycleSettings CycleSettings::from_config(const Config& root) {
   s.plan_orientation_tolerance_rad = p.get_double("orientation_tolerance_rad", 1e-5, 1.0);
   s.held_book_depth_m = p.get_double("held_book_depth_m", 0.01, 1.0);
   s.placed_books_as_obstacles = p.get<bool>("placed_books_as_obstacles");
+  s.placed_book_padding_m = p.get_double("placed_book_padding_m", 0.0, 0.05);
   const Config a = root.child("arm");
   s.heartbeat_period_s = a.get_double("heartbeat_period_s", 0.005, 0.1);
   s.linear_max_speed = a.get_double("linear_max_speed_mps", 0.001, 0.15);
@@ -262,8 +263,9 @@ std::vector<std::pair<std::string, OrientedBox>> LibraryCycle::placed_book_obsta
     // A progress file from before the height was kept: as tall as the lower shelf takes (none if it takes any).
     const double height = std::isfinite(b.height) && b.height > 0 ? b.height : lower_shelf_max_book_height(g);
     if (!std::isfinite(height)) continue;
-    boxes.emplace_back("lower_shelf_book_" + std::to_string(b.index),
-                       lower_shelf_book_box(cart_frame(), b.lower_right_y, b.width, height, s_.held_book_depth_m, g));
+    OrientedBox box = lower_shelf_book_box(cart_frame(), b.lower_right_y, b.width, height, s_.held_book_depth_m, g);
+    box.size += Eigen::Vector3d::Constant(2 * s_.placed_book_padding_m);
+    boxes.emplace_back("lower_shelf_book_" + std::to_string(b.index), box);
   }
   return boxes;
 }

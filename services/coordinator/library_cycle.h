@@ -70,6 +70,9 @@ struct CycleSettings {
   /// Not in the paper: every plan carries the books placed on the lower shelf as boxes (`held_book_depth_m` deep),
   /// so a planned move does not sweep the arm or the held book through them.
   bool placed_books_as_obstacles = true;
+  /// ... each box this much larger on every side than the book measured (its place and the moves past it are a few mm
+  /// off the plan).
+  double placed_book_padding_m = 0.0;
   // arm commands
   double heartbeat_period_s = 0.05;       ///< <= 0.1 s: the driver stops after 0.5 s without
   double linear_max_speed = 0.05;         ///< m/s for straight moves

@@ -726,6 +726,30 @@ struct FullCycleHarness::Impl {
     trace(l + contacts);
   }
 
+  /// "; book N base y [lo hi] ..., TCP (x y z)": where the books are across the shelves (base y) and the TCP.
+  std::string book_extents_y(const mjData* dd, const std::vector<int>& ids) const {
+    const mjModel* mm = sim->world().model().model();
+    std::string l = ";";
+    for (const int id : ids) {
+      const int body = mj_name2id(mm, mjOBJ_BODY, ("book_" + std::to_string(id)).c_str());
+      if (body < 0) continue;
+      double lo = 1e9, hi = -1e9;
+      for (const auto& bk : scene.books)
+        if (bk.id == id)
+          for (const auto& c : scene::book_corners(body_pose(dd, body), bk.width_m, bk.height_m, bk.depth_m)) {
+            lo = std::min(lo, c.y());
+            hi = std::max(hi, c.y());
+          }
+      l += " book " + std::to_string(id) + fmt(" base y [%.4f", lo) + fmt(" %.4f],", hi);
+    }
+    const int site = mj_name2id(mm, mjOBJ_SITE, "gripper");
+    if (site >= 0) {
+      const Eigen::Vector3d tcp = site_position(dd, site);
+      l += fmt(" TCP (%.3f", tcp.x()) + fmt(" %.3f", tcp.y()) + fmt(" %.3f)", tcp.z());
+    }
+    return l;
+  }
+
   /// Verbose: a robot geom touching a book that the gripper is not meant to hold (every pair once per task
   /// state entered): before the grasp any such touch is a collision, e.g. a servo pose's plates pushing the
   /// right-most book over.
@@ -754,7 +778,7 @@ struct FullCycleHarness::Impl {
         const std::string key = "held book " + std::to_string(target_book_id) + " book " + std::to_string(other);
         if (touches_seen.insert(key).second)
           trace("TOUCH_DIAG " + status.state + ": " + key + fmt(" (dist %.4f m,", c.dist) + fmt(" at %.3f", c.pos[0]) +
-                fmt(" %.3f", c.pos[1]) + fmt(" %.3f)", c.pos[2]));
+                fmt(" %.3f", c.pos[1]) + fmt(" %.3f)", c.pos[2]) + book_extents_y(dd, {target_book_id, other}));
         continue;
       }
       if (b < 0 || (r != scene::kOwnerRobotArm && r != scene::kOwnerGripperFinger)) continue;

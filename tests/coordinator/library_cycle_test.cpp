@@ -261,7 +261,8 @@ TEST(LibraryCycle, ThreeBooksWholeCycleEveryTransitionAndPlacements) {
 // Not in the paper: once a book stands on the lower shelf, every plan carries it as a box, so the planner keeps the
 // arm and the next held book clear of it. Boxes by hand (coordinator.yaml; the fake's cart: base = (0.60 + Z,
 // -0.05 - Y, X) of the grasp frame): right covers 0.10, 0.057, 0.019 (gap 0.018), on the lower shelf at X -0.32 as
-// tall as the book (its P1.x), fore-edge on Z -0.04 and planning.held_book_depth_m (0.30) deep.
+// tall as the book (its P1.x), fore-edge on Z -0.04 and planning.held_book_depth_m (0.30) deep, each 5 mm larger
+// on every side (planning.placed_book_padding_m).
 TEST(LibraryCycle, EveryPlanAfterABookStandsOnTheLowerShelfCarriesItAsABox) {
   const auto plans_obstacles = [](const FakeLibrary& f) {
     std::vector<std::vector<std::pair<std::string, bookgrasp::OrientedBox>>> v;
@@ -287,7 +288,8 @@ TEST(LibraryCycle, EveryPlanAfterABookStandsOnTheLowerShelfCarriesItAsABox) {
       const Eigen::Vector3d c(0.60 + (-0.04 + 0.15), -0.05 - (right[i] - width[i] / 2), -0.32 + height[i] / 2);
       EXPECT_TRUE(boxes[i].second.pose.translation().isApprox(c, 1e-9))
           << "book " << i << ": " << boxes[i].second.pose.translation().transpose();
-      EXPECT_TRUE(boxes[i].second.size.isApprox(Eigen::Vector3d(height[i], width[i], 0.30), 1e-9)) << "book " << i;
+      EXPECT_TRUE(boxes[i].second.size.isApprox(Eigen::Vector3d(height[i] + 0.01, width[i] + 0.01, 0.31), 1e-9))
+          << "book " << i << ": " << boxes[i].second.size.transpose();
     }
   }
   for (int i = 0; i < 3; ++i) EXPECT_NEAR(cycle.progress().moved[i].height, height[i], 1e-9);
@@ -316,7 +318,7 @@ TEST(LibraryCycle, EveryPlanAfterABookStandsOnTheLowerShelfCarriesItAsABox) {
   ASSERT_FALSE(first.empty()) << resumed.status().message;
   ASSERT_EQ(first.front().size(), 1u);
   EXPECT_EQ(first.front()[0].first, "lower_shelf_book_0");
-  EXPECT_NEAR(first.front()[0].second.size.x(), 0.274, 1e-9);
+  EXPECT_NEAR(first.front()[0].second.size.x(), 0.274 + 0.01, 1e-9);
   EXPECT_NEAR(first.front()[0].second.pose.translation().z(), -0.32 + 0.274 / 2, 1e-9);
 }
 
@@ -611,7 +613,8 @@ TEST(LibraryCycle, BadDepthKeysNameTheKey) {
         {"lower_shelf.release_opening_m", "release_opening_m: 0.006 ", "release_opening_m: 0.1 "},
         // The 6 mm release opening with a 5 mm gap: the right plate would push the book placed before over.
         {"lower_shelf.gap_m", "gap_m: 0.018 ", "gap_m: 0.005 "},
-        {"planning.placed_books_as_obstacles", "placed_books_as_obstacles: true", "placed_books_as_obstacles: 0.3"}}) {
+        {"planning.placed_books_as_obstacles", "placed_books_as_obstacles: true", "placed_books_as_obstacles: 0.3"},
+        {"planning.placed_book_padding_m", "placed_book_padding_m: 0.005", "placed_book_padding_m: 0.1"}}) {
     std::string text = shipped;
     const auto pos = text.find(line);
     ASSERT_NE(pos, std::string::npos) << line;
