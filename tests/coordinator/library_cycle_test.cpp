@@ -145,8 +145,8 @@ TEST(LibraryCycle, ThreeBooksWholeCycleEveryTransitionAndPlacements) {
   EXPECT_EQ(cycle.status().state, "DONE");
   EXPECT_EQ(cycle.status().books_moved, 3);
 
-  // Lower shelf (coordinator.yaml lower_shelf: first_right_y 0.10, gap 0.018, front_z -0.04, drop 0.32): right covers
-  // at 0.10, 0.10 - 0.025 - 0.018 = 0.057, 0.057 - 0.020 - 0.018 = 0.019; TCP Y = right - BW/2;
+  // Lower shelf (coordinator.yaml lower_shelf: first_right_y 0.10, gap 0.022, front_z -0.04, drop 0.32): right covers
+  // at 0.10, 0.10 - 0.025 - 0.022 = 0.053, 0.053 - 0.020 - 0.022 = 0.011; TCP Y = right - BW/2;
   // Z = -0.04 + 0.03 (insertion) = -0.01. Base = (0.60 + Z, -0.05 - Y, X). X: the book was taken from the holder
   // with the TCP holder.regrasp_lower_m (0.015) lower than at its release, after it had dropped place_clearance_m
   // (0.005) onto the ledge, so the TCP is height - 0.015 + 0.005 above its bottom; the place leaves 0.005 below it:
@@ -154,7 +154,7 @@ TEST(LibraryCycle, ThreeBooksWholeCycleEveryTransitionAndPlacements) {
   // shelf: its top (P1.x) plus grasp.offset_x_m (shipped -0.012: 12 mm below the top).
   const double gx = settings().geometry.grasp_offset_x;
   ASSERT_NEAR(gx, -0.012, 1e-12);
-  const double ys[3] = {0.10 - 0.0125, 0.057 - 0.010, 0.019 - 0.015};
+  const double ys[3] = {0.10 - 0.0125, 0.053 - 0.010, 0.011 - 0.015};
   const double hs[3] = {0.25 + gx, 0.18 + gx, 0.22 + gx};
   for (int i = 0; i < 3; ++i) {
     const Eigen::Vector3d tcp = w.lower[i].second.translation();
@@ -163,7 +163,7 @@ TEST(LibraryCycle, ThreeBooksWholeCycleEveryTransitionAndPlacements) {
     EXPECT_NEAR(tcp.z(), -0.32 + hs[i] - 0.015 + 0.005 + 0.005, 0.0015) << "book " << i;
   }
   // The releases on the lower shelf open the plates to the book + 6 mm (lower_shelf.release_opening_m): 31, 26 and
-  // 36 mm for the 25, 20 and 30 mm books (the 18 mm gap leaves a plate + 5 mm); with 0, fully.
+  // 36 mm for the 25, 20 and 30 mm books (the 22 mm gap leaves a plate + 9 mm); with 0, fully.
   const auto release_opens = [](const FakeLibrary& f) {
     std::vector<double> v;
     for (const CycleRequest& r : f.requests)
@@ -260,8 +260,8 @@ TEST(LibraryCycle, ThreeBooksWholeCycleEveryTransitionAndPlacements) {
 
 // Not in the paper: once a book stands on the lower shelf, every plan carries it as a box, so the planner keeps the
 // arm and the next held book clear of it. Boxes by hand (coordinator.yaml; the fake's cart: base = (0.60 + Z,
-// -0.05 - Y, X) of the grasp frame): right covers 0.10, 0.057, 0.019 (gap 0.018), on the lower shelf at X -0.32 as
-// tall as the book (its P1.x), fore-edge on Z -0.04 and planning.held_book_depth_m (0.30) deep, each 5 mm larger
+// -0.05 - Y, X) of the grasp frame): right covers 0.10, 0.053, 0.011 (gap 0.022), on the lower shelf at X -0.32 as
+// tall as the book (its P1.x), fore-edge on Z -0.04 and planning.held_book_depth_m (0.30) deep, each 10 mm larger
 // on every side (planning.placed_book_padding_m).
 TEST(LibraryCycle, EveryPlanAfterABookStandsOnTheLowerShelfCarriesItAsABox) {
   const auto plans_obstacles = [](const FakeLibrary& f) {
@@ -278,7 +278,7 @@ TEST(LibraryCycle, EveryPlanAfterABookStandsOnTheLowerShelfCarriesItAsABox) {
   ASSERT_GE(plans.size(), 10u);
   EXPECT_TRUE(plans.front().empty());
   EXPECT_EQ(plans.back().size(), 3u) << "the plans after the third book's place";
-  const double right[3] = {0.10, 0.057, 0.019}, width[3] = {0.025, 0.020, 0.030}, height[3] = {0.25, 0.18, 0.22};
+  const double right[3] = {0.10, 0.053, 0.011}, width[3] = {0.025, 0.020, 0.030}, height[3] = {0.25, 0.18, 0.22};
   size_t before = 0;
   for (const auto& boxes : plans) {
     EXPECT_GE(boxes.size(), before) << "a placed book left the planner's world";
@@ -288,7 +288,7 @@ TEST(LibraryCycle, EveryPlanAfterABookStandsOnTheLowerShelfCarriesItAsABox) {
       const Eigen::Vector3d c(0.60 + (-0.04 + 0.15), -0.05 - (right[i] - width[i] / 2), -0.32 + height[i] / 2);
       EXPECT_TRUE(boxes[i].second.pose.translation().isApprox(c, 1e-9))
           << "book " << i << ": " << boxes[i].second.pose.translation().transpose();
-      EXPECT_TRUE(boxes[i].second.size.isApprox(Eigen::Vector3d(height[i] + 0.01, width[i] + 0.01, 0.31), 1e-9))
+      EXPECT_TRUE(boxes[i].second.size.isApprox(Eigen::Vector3d(height[i] + 0.02, width[i] + 0.02, 0.32), 1e-9))
           << "book " << i << ": " << boxes[i].second.size.transpose();
     }
   }
@@ -310,7 +310,7 @@ TEST(LibraryCycle, EveryPlanAfterABookStandsOnTheLowerShelfCarriesItAsABox) {
   old.moved.push_back({0, 0.025, 0.30, 0.10});
   old.moved.push_back({1, 0.020, 0.27, std::numeric_limits<double>::quiet_NaN(), true});
   old.gp_grasp = Eigen::Vector3d(0.0, 0.0, 0.0);
-  old.lower_next_right_y = 0.057;
+  old.lower_next_right_y = 0.053;
   FakeLibrary wr({three_books()[2]});
   LibraryCycle resumed(settings(), old);
   wr.run(resumed, [&] { return !plans_obstacles(wr).empty() || done_or_aborted(resumed); });
@@ -318,7 +318,7 @@ TEST(LibraryCycle, EveryPlanAfterABookStandsOnTheLowerShelfCarriesItAsABox) {
   ASSERT_FALSE(first.empty()) << resumed.status().message;
   ASSERT_EQ(first.front().size(), 1u);
   EXPECT_EQ(first.front()[0].first, "lower_shelf_book_0");
-  EXPECT_NEAR(first.front()[0].second.size.x(), 0.274 + 0.01, 1e-9);
+  EXPECT_NEAR(first.front()[0].second.size.x(), 0.274 + 0.02, 1e-9);
   EXPECT_NEAR(first.front()[0].second.pose.translation().z(), -0.32 + 0.274 / 2, 1e-9);
 }
 
@@ -612,9 +612,9 @@ TEST(LibraryCycle, BadDepthKeysNameTheKey) {
         {"holder.regrasp_min_height_m", "regrasp_min_height_m: 0.15", "regrasp_min_height_m: -0.1"},
         {"lower_shelf.release_opening_m", "release_opening_m: 0.006 ", "release_opening_m: 0.1 "},
         // The 6 mm release opening with a 5 mm gap: the right plate would push the book placed before over.
-        {"lower_shelf.gap_m", "gap_m: 0.018 ", "gap_m: 0.005 "},
+        {"lower_shelf.gap_m", "gap_m: 0.022 ", "gap_m: 0.005 "},
         {"planning.placed_books_as_obstacles", "placed_books_as_obstacles: true", "placed_books_as_obstacles: 0.3"},
-        {"planning.placed_book_padding_m", "placed_book_padding_m: 0.005", "placed_book_padding_m: 0.1"}}) {
+        {"planning.placed_book_padding_m", "placed_book_padding_m: 0.010", "placed_book_padding_m: 0.1"}}) {
     std::string text = shipped;
     const auto pos = text.find(line);
     ASSERT_NE(pos, std::string::npos) << line;
