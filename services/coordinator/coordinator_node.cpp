@@ -180,6 +180,37 @@ void CoordinatorNode::on_user_event(const user_event_t& msg) {
   after_event(msg.utime);
 }
 
+plan_request_t plan_request_message(const CycleRequest& r, const CycleSettings& settings, int64_t utime) {
+  plan_request_t m;
+  m.utime = utime;
+  m.request_id = r.id;
+  m.planner = settings.planner;
+  m.goal_type = r.joints_goal ? plan_request_t::JOINTS : plan_request_t::POSE;
+  m.num_joints = static_cast<int32_t>(r.start_joints.size());
+  m.start_joints = r.start_joints;
+  m.goal_joints = r.joints_goal ? r.goal_joints : std::vector<double>(r.start_joints.size(), 0.0);
+  m.goal_joints.resize(r.start_joints.size(), 0.0);
+  m.goal_pose = isometry_to_pose(r.pose, "base", "gripper", utime);
+  m.position_tolerance_m = settings.plan_position_tolerance_m;
+  m.orientation_tolerance_rad = settings.plan_orientation_tolerance_rad;
+  m.keep_orientation = false;
+  m.time_budget_s = settings.plan_time_budget_s;
+  m.holding_book = r.holding_book;
+  for (int i = 0; i < 3; ++i) m.held_book_size_m[i] = r.book_size[i];
+  m.num_then_poses = static_cast<int32_t>(r.then_poses.size());
+  for (const Eigen::Isometry3d& p : r.then_poses) m.then_poses.push_back(isometry_to_pose(p, "base", "gripper", utime));
+  m.num_obstacles = static_cast<int32_t>(r.obstacles.size());
+  for (const auto& [name, box] : r.obstacles) {
+    obstacle_box_t o;
+    o.utime = utime;
+    o.name = name;
+    o.pose = isometry_to_pose(box.pose, "base", name, utime);
+    for (int i = 0; i < 3; ++i) o.size_m[i] = box.size[i];
+    m.obstacles.push_back(o);
+  }
+  return m;
+}
+
 void CoordinatorNode::send(const std::vector<CycleRequest>& requests, int64_t utime) {
   for (const CycleRequest& r : requests) {
     switch (r.kind) {
@@ -199,35 +230,7 @@ void CoordinatorNode::send(const std::vector<CycleRequest>& requests, int64_t ut
         break;
       }
       case CycleRequest::Kind::kPlan: {
-        plan_request_t m;
-        m.utime = utime;
-        m.request_id = r.id;
-        m.planner = settings_.planner;
-        m.goal_type = r.joints_goal ? plan_request_t::JOINTS : plan_request_t::POSE;
-        m.num_joints = static_cast<int32_t>(r.start_joints.size());
-        m.start_joints = r.start_joints;
-        m.goal_joints = r.joints_goal ? r.goal_joints : std::vector<double>(r.start_joints.size(), 0.0);
-        m.goal_joints.resize(r.start_joints.size(), 0.0);
-        m.goal_pose = isometry_to_pose(r.pose, "base", "gripper", utime);
-        m.position_tolerance_m = settings_.plan_position_tolerance_m;
-        m.orientation_tolerance_rad = settings_.plan_orientation_tolerance_rad;
-        m.keep_orientation = false;
-        m.time_budget_s = settings_.plan_time_budget_s;
-        m.holding_book = r.holding_book;
-        for (int i = 0; i < 3; ++i) m.held_book_size_m[i] = r.book_size[i];
-        m.num_then_poses = static_cast<int32_t>(r.then_poses.size());
-        for (const Eigen::Isometry3d& p : r.then_poses)
-          m.then_poses.push_back(isometry_to_pose(p, "base", "gripper", utime));
-        m.num_obstacles = static_cast<int32_t>(r.obstacles.size());
-        for (const auto& [name, box] : r.obstacles) {
-          obstacle_box_t o;
-          o.utime = utime;
-          o.name = name;
-          o.pose = isometry_to_pose(box.pose, "base", name, utime);
-          for (int i = 0; i < 3; ++i) o.size_m[i] = box.size[i];
-          m.obstacles.push_back(o);
-        }
-        publish(ch_.plan_request, m);
+        publish(ch_.plan_request, plan_request_message(r, settings_, utime));
         break;
       }
       case CycleRequest::Kind::kExecutePlan:

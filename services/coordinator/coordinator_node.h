@@ -14,6 +14,7 @@
 #include "bookgrasp/grasp_point_t.hpp"
 #include "bookgrasp/joint_trajectory_t.hpp"
 #include "bookgrasp/marker_detections_t.hpp"
+#include "bookgrasp/plan_request_t.hpp"
 #include "bookgrasp/plan_result_t.hpp"
 #include "bookgrasp/servo_status_t.hpp"
 #include "bookgrasp/user_event_t.hpp"
@@ -25,6 +26,10 @@ namespace bookgrasp {
 
 /// Parses the outcome word of a GRASP_POINT reason ("NEXT_REGION rank 2: ..." -> "NEXT_REGION", rank 2).
 DecisionEvent decision_from_message(const grasp_point_t& msg);
+
+/// The PLAN_REQUEST of a kPlan request `r` at `utime`: planner, tolerances and budget from `settings`, the goal,
+/// the straight moves after it and the boxes to avoid (the books on the lower shelf), all in base.
+plan_request_t plan_request_message(const CycleRequest& r, const CycleSettings& settings, int64_t utime);
 
 /// The coordinator component.
 class CoordinatorNode : public Component {

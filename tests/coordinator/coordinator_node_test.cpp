@@ -220,6 +220,51 @@ TEST_F(CoordinatorNodeTest, CorruptProgressFileFailsAtStartNamingTheFile) {
   }
 }
 
+// A plan with a held book, one straight move after it and two placed books to avoid, as the message the planner reads
+// (it decodes after an encode, with every box's name, pose in base and size).
+TEST(PlanRequestMessage, CarriesTheHeldBookTheStraightMovesAndTheBoxesToAvoid) {
+  CycleSettings s;
+  s.planner = "RRTConnect";
+  s.plan_position_tolerance_m = 0.002;
+  s.plan_orientation_tolerance_rad = 0.02;
+  s.plan_time_budget_s = 10.0;
+  CycleRequest r;
+  r.kind = CycleRequest::Kind::kPlan;
+  r.id = 17;
+  r.start_joints = {0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7};
+  r.pose.translation() = Eigen::Vector3d(0.6, -0.1, -0.1);
+  r.holding_book = true;
+  r.book_size = Eigen::Vector3d(0.02, 0.25, 0.30);
+  r.then_poses = {r.pose};
+  for (int i = 0; i < 2; ++i) {
+    OrientedBox b;
+    b.pose.translation() = Eigen::Vector3d(0.9, -0.14 + 0.04 * i, -0.19);
+    b.size = Eigen::Vector3d(0.27, 0.04, 0.32);
+    r.obstacles.emplace_back("lower_shelf_book_" + std::to_string(i), b);
+  }
+  const plan_request_t m = plan_request_message(r, s, 5000);
+  std::vector<uint8_t> buf(m.getEncodedSize());
+  ASSERT_EQ(m.encode(buf.data(), 0, static_cast<int>(buf.size())), static_cast<int>(buf.size()));
+  plan_request_t d;
+  ASSERT_EQ(d.decode(buf.data(), 0, static_cast<int>(buf.size())), static_cast<int>(buf.size()));
+  EXPECT_EQ(d.request_id, 17);
+  EXPECT_EQ(d.planner, "RRTConnect");
+  EXPECT_EQ(d.goal_type, plan_request_t::POSE);
+  EXPECT_TRUE(d.holding_book);
+  EXPECT_EQ(d.held_book_size_m[1], 0.25);
+  EXPECT_EQ(d.num_then_poses, 1);
+  ASSERT_EQ(d.num_obstacles, 2);
+  ASSERT_EQ(d.obstacles.size(), 2u);
+  EXPECT_EQ(d.obstacles[1].name, "lower_shelf_book_1");
+  EXPECT_EQ(d.obstacles[1].pose.frame, "base");
+  EXPECT_NEAR(d.obstacles[1].pose.position[1], -0.10, 1e-12);
+  EXPECT_NEAR(d.obstacles[1].pose.orientation[0], 1.0, 1e-12);
+  EXPECT_EQ(d.obstacles[0].size_m[0], 0.27);
+  EXPECT_EQ(d.obstacles[0].size_m[2], 0.32);
+  r.obstacles.clear();
+  EXPECT_EQ(plan_request_message(r, s, 5000).num_obstacles, 0);
+}
+
 TEST(DecisionFromMessage, ParsesOutcomeAndRank) {
   grasp_point_t g;
   g.utime = 5;
