@@ -29,6 +29,9 @@
 #ifdef BOOKGRASP_HAVE_BWS_DETECTOR
 #include "services/bws_detector/bws_detector_service.h"
 #endif
+#ifdef BOOKGRASP_HAVE_PLANNER
+#include "services/planner/planner_service.h"
+#endif
 
 namespace bookgrasp {
 
@@ -60,6 +63,9 @@ ComponentRegistry project_services() {
 #endif
 #ifdef BOOKGRASP_HAVE_BWS_DETECTOR
   r.add(bws_detector_service());
+#endif
+#ifdef BOOKGRASP_HAVE_PLANNER
+  r.add(planner_service());
 #endif
   return r;
 }

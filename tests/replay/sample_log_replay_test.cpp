@@ -7,6 +7,7 @@
 #include <fstream>
 #include <regex>
 
+#include "bookgrasp/plan_result_t.hpp"
 #include "services/replay/component_registry.h"
 #include "services/replay/output_diff.h"
 #include "services/replay/replay_runner.h"
@@ -147,6 +148,85 @@ TEST(ArbiterReplay, TighterP1ToleranceChangesTheDecisions) {
   std::ofstream(path) << changed;
   const DiffReport r = replay_arbiter(path);
   EXPECT_FALSE(r.identical()) << "a 0.1 mm P1-PS tolerance must reject the recorded P1:\n" << r.markdown();
+}
+
+}  // namespace
+}  // namespace bookgrasp
+
+namespace bookgrasp {
+namespace {
+
+// logs/samples/planner_lower_shelf.lcm: PLAN_REQUEST, PLAN_RESULT and MARKERS of the deployed main job
+// (logs/demo-20261205-153617.lcm, 400-600 s, cut by deploy/filter_log.py), recorded with planner.yaml's
+// max_search_steps at 30000. Books 5, 6 and 7 went from the holder towards lower-shelf slots near y = 0; the first
+// request of each (and all but one retry) ended "CellBiRRT found no path within 30000 search steps", so two of them
+// were handed over to the librarian.
+const std::string kPlannerSample = std::string(BOOKGRASP_SOURCE_DIR) + "/logs/samples/planner_lower_shelf.lcm";
+
+std::string planner_config_with_steps(const std::string& steps) {
+  std::ifstream in(std::string(BOOKGRASP_SOURCE_DIR) + "/config/services/planner.yaml");
+  std::stringstream ss;
+  ss << in.rdbuf();
+  const std::string changed =
+      std::regex_replace(ss.str(), std::regex("max_search_steps: [0-9]+"), "max_search_steps: " + steps);
+  EXPECT_NE(changed.find("max_search_steps: " + steps), std::string::npos);
+  const std::string path = testing::TempDir() + "/planner_steps_" + steps + ".yaml";
+  std::ofstream(path) << changed;
+  return path;
+}
+
+std::vector<plan_result_t> plan_results(const std::vector<LoggedMessage>& messages) {
+  std::vector<plan_result_t> out;
+  for (const auto& m : messages) {
+    if (m.channel != "PLAN_RESULT") continue;
+    plan_result_t r;
+    EXPECT_GT(r.decode(m.data.data(), 0, static_cast<int>(m.data.size())), 0);
+    out.push_back(r);
+  }
+  return out;
+}
+
+ReplayRun replay_planner(const std::vector<LoggedMessage>& log, const std::string& config_path) {
+  std::vector<std::unique_ptr<Component>> cs;
+  cs.push_back(project_services().make("planner", config_path, BOOKGRASP_SOURCE_DIR));
+  return replay_log(log, std::move(cs));
+}
+
+// The planner is seeded by each request's identity, and its search ends after a count of steps, not by the clock:
+// with the configuration it ran with, every recorded plan and every recorded failure comes back byte for byte.
+TEST(PlannerReplay, TheRecordedBudgetReproducesEveryPlanAndFailureBitForBit) {
+  const auto log = read_lcm_log(kPlannerSample);
+  const ReplayRun run = replay_planner(log, planner_config_with_steps("30000"));
+  const DiffReport r = diff_outputs(log, run.outputs, {"PLAN_RESULT"}, {"planning_time_s"}, run.fed_utimes);
+  ASSERT_EQ(r.channels.size(), 1u) << r.markdown();
+  EXPECT_EQ(r.channels[0].matched, 26) << r.markdown();
+  EXPECT_TRUE(r.identical()) << r.markdown();
+  int failed = 0;
+  for (const auto& p : plan_results(run.outputs)) failed += p.success ? 0 : 1;
+  EXPECT_EQ(failed, 7) << "the sample holds the deployed run's seven 'no path' answers";
+}
+
+// With the shipped budget the first request of every move in the sample gets a collision-free path, among them the
+// three the deployed run failed (a retry carries its first request's utime, so a first request has request_id ==
+// utime). Plans the recording found are found again unchanged: the budget only matters where a search ran out.
+TEST(PlannerReplay, TheShippedBudgetPlansEveryFirstRequestTheRecordingMissed) {
+  const auto log = read_lcm_log(kPlannerSample);
+  const std::vector<plan_result_t> recorded = plan_results(log);
+  const std::vector<plan_result_t> replayed = plan_results(replay_planner(log, "").outputs);
+  ASSERT_EQ(replayed.size(), recorded.size());
+  int missed_first_tries = 0;
+  for (size_t i = 0; i < recorded.size(); ++i) {
+    ASSERT_EQ(replayed[i].request_id, recorded[i].request_id);
+    if (recorded[i].success) {
+      EXPECT_TRUE(replayed[i].success) << replayed[i].request_id;
+      EXPECT_EQ(replayed[i].trajectory.num_points, recorded[i].trajectory.num_points) << replayed[i].request_id;
+      EXPECT_EQ(replayed[i].path_length_rad, recorded[i].path_length_rad) << replayed[i].request_id;
+    }
+    if (recorded[i].request_id != recorded[i].utime) continue;
+    EXPECT_TRUE(replayed[i].success) << replayed[i].request_id << ": " << replayed[i].message;
+    if (!recorded[i].success) ++missed_first_tries;
+  }
+  EXPECT_EQ(missed_first_tries, 3);
 }
 
 }  // namespace
