@@ -32,6 +32,9 @@
 #ifdef BOOKGRASP_HAVE_PLANNER
 #include "services/planner/planner_service.h"
 #endif
+#ifdef BOOKGRASP_HAVE_VISUAL_SERVO
+#include "services/visual_servo/visual_servo_service.h"
+#endif
 
 namespace bookgrasp {
 
@@ -66,6 +69,9 @@ ComponentRegistry project_services() {
 #endif
 #ifdef BOOKGRASP_HAVE_PLANNER
   r.add(planner_service());
+#endif
+#ifdef BOOKGRASP_HAVE_VISUAL_SERVO
+  r.add(visual_servo_service());
 #endif
   return r;
 }
