@@ -1,12 +1,16 @@
 // `deploy/bookgrasp swap` on a running process system under supervisord: one implementation is
-// replaced by another without touching anything else; output continues within 1 s; the switch is
-// on the bus (DETECTOR_SWITCH) and in SERVICE_STATUS.
+// replaced by another without touching anything else; output continues within 1 s (issue 8); the switch is
+// on the bus (DETECTOR_SWITCH) and in SERVICE_STATUS. The swap makes before it breaks (the old implementation
+// is stopped only after the new one reports and the switch is sent), so the output's longest silence is the
+// input's period, not the new process's start-up time: on a loaded machine a break-before-make swap left a
+// 2.4 s gap here (2026-12-05).
 #include <gtest/gtest.h>
 
 #include <unistd.h>
 
 #include <atomic>
 #include <chrono>
+#include <cstdio>
 #include <cstdlib>
 #include <fstream>
 #include <thread>
@@ -99,6 +103,8 @@ TEST(ProcessSwap, ReplacesOneImplementationAndOutputContinuesWithinOneSecond) {
   double max_gap = 0;
   for (size_t i = 1; i < l.out.size(); ++i)
     max_gap = std::max(max_gap, std::chrono::duration<double>(l.out[i].first - l.out[i - 1].first).count());
+  RecordProperty("longest_output_silence_s", std::to_string(max_gap));
+  std::printf("longest output silence during the swap: %.3f s (%zu outputs)\n", max_gap, l.out.size());
   EXPECT_LT(max_gap, 1.0) << "output stopped for " << max_gap << " s during the swap";
   // The switch is on the bus and in SERVICE_STATUS.
   ASSERT_EQ(l.switches.size(), 1u);
