@@ -145,8 +145,8 @@ TEST(LibraryCycle, ThreeBooksWholeCycleEveryTransitionAndPlacements) {
   EXPECT_EQ(cycle.status().state, "DONE");
   EXPECT_EQ(cycle.status().books_moved, 3);
 
-  // Lower shelf (coordinator.yaml lower_shelf: first_right_y 0.10, gap 0.022, front_z -0.04, drop 0.32): right covers
-  // at 0.10, 0.10 - 0.025 - 0.022 = 0.053, 0.053 - 0.020 - 0.022 = 0.011; TCP Y = right - BW/2;
+  // Lower shelf (coordinator.yaml lower_shelf: first_right_y 0.16, gap 0.022, front_z -0.04, drop 0.32): right covers
+  // at 0.16, 0.16 - 0.025 - 0.022 = 0.113, 0.113 - 0.020 - 0.022 = 0.071; TCP Y = right - BW/2;
   // Z = -0.04 + 0.03 (insertion) = -0.01. Base = (0.60 + Z, -0.05 - Y, X). X: the book was taken from the holder
   // with the TCP holder.regrasp_lower_m (0.015) lower than at its release, after it had dropped place_clearance_m
   // (0.005) onto the ledge, so the TCP is height - 0.015 + 0.005 above its bottom; the place leaves 0.005 below it:
@@ -154,7 +154,8 @@ TEST(LibraryCycle, ThreeBooksWholeCycleEveryTransitionAndPlacements) {
   // shelf: its top (P1.x) plus grasp.offset_x_m (shipped -0.012: 12 mm below the top).
   const double gx = settings().geometry.grasp_offset_x;
   ASSERT_NEAR(gx, -0.012, 1e-12);
-  const double ys[3] = {0.10 - 0.0125, 0.053 - 0.010, 0.011 - 0.015};
+  ASSERT_NEAR(settings().geometry.lower_first_right_y, 0.16, 1e-12);
+  const double ys[3] = {0.16 - 0.0125, 0.113 - 0.010, 0.071 - 0.015};
   const double hs[3] = {0.25 + gx, 0.18 + gx, 0.22 + gx};
   for (int i = 0; i < 3; ++i) {
     const Eigen::Vector3d tcp = w.lower[i].second.translation();
@@ -278,7 +279,8 @@ TEST(LibraryCycle, EveryPlanAfterABookStandsOnTheLowerShelfCarriesItAsABox) {
   ASSERT_GE(plans.size(), 10u);
   EXPECT_TRUE(plans.front().empty());
   EXPECT_EQ(plans.back().size(), 3u) << "the plans after the third book's place";
-  const double right[3] = {0.10, 0.053, 0.011}, width[3] = {0.025, 0.020, 0.030}, height[3] = {0.25, 0.18, 0.22};
+  ASSERT_NEAR(settings().geometry.lower_first_right_y, 0.16, 1e-12);
+  const double right[3] = {0.16, 0.113, 0.071}, width[3] = {0.025, 0.020, 0.030}, height[3] = {0.25, 0.18, 0.22};
   size_t before = 0;
   for (const auto& boxes : plans) {
     EXPECT_GE(boxes.size(), before) << "a placed book left the planner's world";
