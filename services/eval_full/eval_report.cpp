@@ -93,10 +93,11 @@ double rate(int k, int n) { return n > 0 ? static_cast<double>(k) / n : NAN; }
 void write_report(const std::string& dir, const EvalMetrics& m, const std::string& command, int books_per_scene) {
   // Plots (PNG, OpenCV).
   cv::imwrite(dir + "/rates.png",
-              rates_plot({"grasp", "P1-P2 agree", "width<1cm", "books moved"},
+              rates_plot({"grasp", "P1-P2 agree", "width<1cm", "books moved", "upright"},
                          {rate(m.grasp_successes, m.grasp_attempts), rate(m.decisions_agreeing, m.decisions),
-                          rate(m.widths_within, m.widths), rate(m.books_moved, m.books_targeted)},
-                         {0.75, 0.80, 0.65, NAN}));
+                          rate(m.widths_within, m.widths), rate(m.books_moved, m.books_targeted),
+                          rate(m.books_upright_on_lower_shelf, m.books_upright_checked)},
+                         {0.75, 0.80, 0.65, NAN, NAN}));
   cv::imwrite(dir + "/width_error.png",
               histogram(m.width_error_mm, 0, 20, 20, "book width error |BW - true| (paper Fig. 15)", "mm", {10}));
   std::vector<double> dy = m.p1_p2_dy_mm;
