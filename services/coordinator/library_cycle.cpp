@@ -616,7 +616,8 @@ void LibraryCycle::after_motion() {
       succeed(CycleState::kLiftFromHolder);
       return;
     case CycleState::kBackOutFromHolder:
-      succeed(CycleState::kMoveToHolderPreGrasp);
+      // A book left to the librarian (leave_on_holder) is not grasped again: park and wait for "taken".
+      succeed(progress_.hand_over_reason.empty() ? CycleState::kMoveToHolderPreGrasp : CycleState::kParkForUser);
       return;
     case CycleState::kLiftFromHolder:
       if (book_lost_from_plates()) return;
@@ -671,12 +672,17 @@ void LibraryCycle::book_done(bool handed_over) {
     message_ = "book " + std::to_string(b.index) + where;
   }
   attempt_ = 1;
+  step_retries_ = 0;
+  retrying_ = CycleState::kStart;
   rerouting_ = false;
   narrow_after_more_than_the_book_ = false;
 }
 
 void LibraryCycle::succeed(CycleState next) {
-  step_retries_ = 0;
+  if (retrying_ == CycleState::kStart || state_ == retrying_) {
+    step_retries_ = 0;
+    retrying_ = CycleState::kStart;
+  }
   enter(next);
 }
 
@@ -936,18 +942,25 @@ void LibraryCycle::fail(const std::string& reason) {
                " after: " + reason;
     const bool inside = in(state_, {CycleState::kInsert, CycleState::kCloseGripper});
     step_retries_ = 0;
+    retrying_ = CycleState::kStart;
     enter(inside ? CycleState::kBackOut : CycleState::kPark);
     return;
   }
   if (step_retries_ >= s_.max_step_retries) {
-    const std::string why = cycle_state_name(state_) + " failed " + std::to_string(step_retries_ + 1) +
+    const std::string why = (retrying_ == CycleState::kStart ? cycle_state_name(state_) : cycle_state_name(retrying_)) +
+                            " failed " + std::to_string(step_retries_ + 1) +
                             " times (retries.max_step_retries), last: " + reason;
+    step_retries_ = 0;
+    retrying_ = CycleState::kStart;
     if (state_ == CycleState::kMoveToLowerShelf)
       return_to_holder(why);  // the lower shelf cannot take the book
+    else if (progress_.place == BookPlace::kOnHolder)
+      leave_on_holder(why);  // the book cannot be taken from the holder again
     else
       abort(why + "; the book is on/in the " + book_place_name(progress_.place));
     return;
   }
+  if (retrying_ == CycleState::kStart) retrying_ = state_;
   step_retries_ += 1;
   message_ = "retry " + std::to_string(step_retries_) + " of " + cycle_state_name(state_) + " after: " + reason;
   // A missed grasp on the holder: straight out (the planner does not plan from between the holder's plates:
@@ -965,7 +978,21 @@ void LibraryCycle::return_to_holder(const std::string& why) {
   progress_.hand_over_reason = why;
   message_ = "book " + std::to_string(progress_.books_moved) + " goes back onto the holder for the librarian: " + why;
   step_retries_ = 0;
+  retrying_ = CycleState::kStart;
   enter(CycleState::kMoveToHolder);
+}
+
+void LibraryCycle::leave_on_holder(const std::string& why) {
+  if (!s_.hand_over_unplaceable || !progress_.hand_over_reason.empty()) {
+    abort(why + "; the book is on/in the " + book_place_name(progress_.place) +
+          (s_.hand_over_unplaceable ? "" : " (retries.hand_over_unplaceable is off)"));
+    return;
+  }
+  progress_.hand_over_reason = why;
+  message_ = "book " + std::to_string(progress_.books_moved) + " stays on the holder for the librarian: " + why;
+  // Out of the holder first where the plates may be around the book; then park and wait for "taken".
+  const bool at_book = in(state_, {CycleState::kApproachHolder, CycleState::kGraspFromHolder});
+  enter(at_book ? CycleState::kBackOutFromHolder : CycleState::kParkForUser);
 }
 
 void LibraryCycle::abort(const std::string& reason) {

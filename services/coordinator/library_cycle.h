@@ -354,6 +354,9 @@ class LibraryCycle {
   /// The lower shelf cannot take the held book (`why`): with hand_over_unplaceable it goes back onto the holder
   /// for the librarian (MOVE_TO_HOLDER ... WAIT_BOOK_TAKEN), else the task aborts with the book held.
   void return_to_holder(const std::string& why);
+  /// The book on the holder cannot be grasped again (`why`, its retries used up): with hand_over_unplaceable it stays
+  /// there for the librarian (out of the holder, PARK_FOR_USER, WAIT_BOOK_TAKEN), else the task aborts.
+  void leave_on_holder(const std::string& why);
   /// Height of the book the planner is told about while it is held (GP.x).
   double held_box_height() const;
   /// BwH from the P1 check's or PS check's answer: its start point (P1 or PS) and the book front's Z.
@@ -379,6 +382,9 @@ class LibraryCycle {
   std::vector<CycleRequest> out_;
   int attempt_ = 1;
   int step_retries_ = 0;
+  /// The step whose failure the retries count (kStart = none). Only its own success resets step_retries_: a retry of
+  /// GRASP_FROM_HOLDER passes through BACK_OUT_FROM_HOLDER .. APPROACH_HOLDER, whose successes must not reset it.
+  CycleState retrying_ = CycleState::kStart;
   /// The stripe end was measured in this attempt, or the attempt re-routes BwH (P1_LED_ASTRAY, RAISE_BWH_START,
   /// START_FROM_P1) at a measured PS: a P1 check without P1 starts BwH instead of checking the stripe again.
   bool stripe_done_this_attempt_ = false;

@@ -1239,5 +1239,32 @@ TEST(TaskProgress, RoundTripAndCorruptFilesAreNamed) {
   EXPECT_FALSE(bookgrasp::load_progress(testing::TempDir() + "/does_not_exist.yaml"));
 }
 
+// A book the plates keep missing on the holder: each miss backs out and comes back (BACK_OUT_FROM_HOLDER ..
+// APPROACH_HOLDER succeed on the way), and those steps' successes do not reset the count, so after
+// retries.max_step_retries (2) retries the book stays on the holder for the librarian and the task goes on. Before
+// (stop 32's code) every back-out reset the count: far_cart seed 3, whole shelf, went round 99 times.
+TEST(LibraryCycle, ABookThePlatesKeepMissingOnTheHolderStaysThereForTheLibrarian) {
+  FakeLibrary w(three_books());
+  w.missed_holder_grasps = 1000;  // no book is ever grasped from the holder
+  LibraryCycle cycle(settings(), std::nullopt);
+  ASSERT_EQ(settings().max_step_retries, 2);
+  w.run(cycle, [&] { return done_or_aborted(cycle) || count(w.states, "GRASP_FROM_HOLDER") > 30; });
+  EXPECT_EQ(count(w.states, "GRASP_FROM_HOLDER"), 9) << "1 try + 2 retries for each of the three books";
+  EXPECT_EQ(cycle.state(), CycleState::kDone) << cycle.status().message;
+  ASSERT_FALSE(w.taken_by_librarian.empty());
+  EXPECT_EQ(w.taken_by_librarian.size(), 3u) << "every book: the fake misses every holder grasp";
+  EXPECT_TRUE(w.lower.empty());
+  // After the third miss: straight out of the holder, park, wait for "taken".
+  std::vector<std::string> around;
+  for (size_t i = 0; i + 3 < w.states.size(); ++i)
+    if (w.states[i + 3] == "WAIT_BOOK_TAKEN") {
+      around = {w.states[i], w.states[i + 1], w.states[i + 2], w.states[i + 3]};
+      break;
+    }
+  EXPECT_EQ(around, (std::vector<std::string>{"GRASP_FROM_HOLDER", "BACK_OUT_FROM_HOLDER", "PARK_FOR_USER",
+                                              "WAIT_BOOK_TAKEN"}));
+  EXPECT_EQ(cycle.progress().books_moved, 3);
+}
+
 }  // namespace
 }  // namespace bookgrasp_test
