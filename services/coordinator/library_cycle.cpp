@@ -969,26 +969,26 @@ void LibraryCycle::fail(const std::string& reason) {
   enter(again);
 }
 
-void LibraryCycle::return_to_holder(const std::string& why) {
+bool LibraryCycle::begin_hand_over(const std::string& why) {
   if (!s_.hand_over_unplaceable || !progress_.hand_over_reason.empty()) {
     abort(why + "; the book is on/in the " + book_place_name(progress_.place) +
           (s_.hand_over_unplaceable ? "" : " (retries.hand_over_unplaceable is off)"));
-    return;
+    return false;
   }
   progress_.hand_over_reason = why;
-  message_ = "book " + std::to_string(progress_.books_moved) + " goes back onto the holder for the librarian: " + why;
   step_retries_ = 0;
   retrying_ = CycleState::kStart;
+  return true;
+}
+
+void LibraryCycle::return_to_holder(const std::string& why) {
+  if (!begin_hand_over(why)) return;
+  message_ = "book " + std::to_string(progress_.books_moved) + " goes back onto the holder for the librarian: " + why;
   enter(CycleState::kMoveToHolder);
 }
 
 void LibraryCycle::leave_on_holder(const std::string& why) {
-  if (!s_.hand_over_unplaceable || !progress_.hand_over_reason.empty()) {
-    abort(why + "; the book is on/in the " + book_place_name(progress_.place) +
-          (s_.hand_over_unplaceable ? "" : " (retries.hand_over_unplaceable is off)"));
-    return;
-  }
-  progress_.hand_over_reason = why;
+  if (!begin_hand_over(why)) return;
   message_ = "book " + std::to_string(progress_.books_moved) + " stays on the holder for the librarian: " + why;
   // Out of the holder first where the plates may be around the book; then park and wait for "taken".
   const bool at_book = in(state_, {CycleState::kApproachHolder, CycleState::kGraspFromHolder});

@@ -354,6 +354,9 @@ class LibraryCycle {
   /// The lower shelf cannot take the held book (`why`): with hand_over_unplaceable it goes back onto the holder
   /// for the librarian (MOVE_TO_HOLDER ... WAIT_BOOK_TAKEN), else the task aborts with the book held.
   void return_to_holder(const std::string& why);
+  /// Starts leaving the current book to the librarian for `why` (hand_over_reason, retry count cleared). Without
+  /// hand_over_unplaceable, or when the book is already being handed over, aborts instead and returns false.
+  bool begin_hand_over(const std::string& why);
   /// The book on the holder cannot be grasped again (`why`, its retries used up): with hand_over_unplaceable it stays
   /// there for the librarian (out of the holder, PARK_FOR_USER, WAIT_BOOK_TAKEN), else the task aborts.
   void leave_on_holder(const std::string& why);
