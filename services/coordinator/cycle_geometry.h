@@ -209,8 +209,8 @@ struct OrientedBox {
 };
 /// The volume of a book standing on the lower shelf with its right cover at grasp Y `right_y`, `width` wide and
 /// `height` tall, its fore-edge on the plane `lower_front_z` and `depth` deep into the shelf. Its axes are the grasp
-/// frame's (x up: the height, y: the width, z into the cart: the depth); its pose is in the frame `grasp_frame` is
-/// given in (base).
+/// frame's (x up: the height, y: the width, z into the cart: the depth); its pose is in base, the frame
+/// `grasp_frame` is given in.
 OrientedBox lower_shelf_book_box(const Eigen::Isometry3d& grasp_frame, double right_y, double width, double height,
                                  double depth, const CycleGeometry& g);
 /// TCP pose that stands the held book on the lower shelf with its right cover at grasp Y `right_y`.

@@ -20,6 +20,20 @@ const std::string kSample = std::string(BOOKGRASP_SOURCE_DIR) + "/logs/samples/s
 // Wall-clock timing fields are the only ones that are not reproducible.
 const std::set<std::string> kTiming = {"processing_ms", "disparity_ms", "segmentation_ms", "total_ms"};
 
+// config/services/<service>.yaml with `pattern` replaced by `replacement`, written to TempDir()/<file>; "" when the
+// replacement changed nothing (the shipped file no longer has the pattern).
+std::string shipped_config_with(const std::string& service, const std::string& pattern, const std::string& replacement,
+                                const std::string& file) {
+  std::ifstream in(std::string(BOOKGRASP_SOURCE_DIR) + "/config/services/" + service + ".yaml");
+  std::stringstream ss;
+  ss << in.rdbuf();
+  const std::string changed = std::regex_replace(ss.str(), std::regex(pattern), replacement);
+  if (changed == ss.str()) return "";
+  const std::string path = testing::TempDir() + "/" + file;
+  std::ofstream(path) << changed;
+  return path;
+}
+
 DiffReport replay_chain(const std::vector<std::string>& services) {
   const auto log = read_lcm_log(kSample);
   std::vector<std::unique_ptr<Component>> cs;
@@ -77,13 +91,9 @@ TEST(SampleReplay, ChainFromTheStereoCameraReproducesMarkersAndP1) {
 
 TEST(SampleReplay, ChangedParameterIsReported) {
   // bswh_detector with a different stripe threshold: the stripe outputs move and the report says where.
-  std::ifstream in(std::string(BOOKGRASP_SOURCE_DIR) + "/config/services/bswh_detector.yaml");
-  std::stringstream ss;
-  ss << in.rdbuf();
-  const std::string changed = std::regex_replace(ss.str(), std::regex("dark_ratio: 0\\.5"), "dark_ratio: 0.8");
-  ASSERT_NE(changed, ss.str());
-  const std::string path = testing::TempDir() + "/bswh_changed.yaml";
-  std::ofstream(path) << changed;
+  const std::string path =
+      shipped_config_with("bswh_detector", "dark_ratio: 0\\.5", "dark_ratio: 0.8", "bswh_changed.yaml");
+  ASSERT_FALSE(path.empty());
   const DiffReport r = replay("bswh_detector", path);
   EXPECT_FALSE(r.identical()) << r.markdown();
   ASSERT_EQ(r.channels.size(), 1u);
@@ -140,13 +150,9 @@ TEST(ArbiterReplay, ShippedConfigReproducesEveryDecisionBitForBit) {
 }
 
 TEST(ArbiterReplay, TighterP1ToleranceChangesTheDecisions) {
-  std::ifstream in(std::string(BOOKGRASP_SOURCE_DIR) + "/config/services/arbiter.yaml");
-  std::stringstream ss;
-  ss << in.rdbuf();
-  const std::string changed = std::regex_replace(ss.str(), std::regex("p1_ps_y_m: 0\\.010"), "p1_ps_y_m: 0.0001");
-  ASSERT_NE(changed, ss.str());
-  const std::string path = testing::TempDir() + "/arbiter_tight.yaml";
-  std::ofstream(path) << changed;
+  const std::string path =
+      shipped_config_with("arbiter", "p1_ps_y_m: 0\\.010", "p1_ps_y_m: 0.0001", "arbiter_tight.yaml");
+  ASSERT_FALSE(path.empty());
   const DiffReport r = replay_arbiter(path);
   EXPECT_FALSE(r.identical()) << "a 0.1 mm P1-PS tolerance must reject the recorded P1:\n" << r.markdown();
 }
@@ -165,14 +171,9 @@ namespace {
 const std::string kPlannerSample = std::string(BOOKGRASP_SOURCE_DIR) + "/logs/samples/planner_lower_shelf.lcm";
 
 std::string planner_config_with_steps(const std::string& steps) {
-  std::ifstream in(std::string(BOOKGRASP_SOURCE_DIR) + "/config/services/planner.yaml");
-  std::stringstream ss;
-  ss << in.rdbuf();
-  const std::string changed =
-      std::regex_replace(ss.str(), std::regex("max_search_steps: [0-9]+"), "max_search_steps: " + steps);
-  EXPECT_NE(changed.find("max_search_steps: " + steps), std::string::npos);
-  const std::string path = testing::TempDir() + "/planner_steps_" + steps + ".yaml";
-  std::ofstream(path) << changed;
+  const std::string path = shipped_config_with("planner", "max_search_steps: [0-9]+", "max_search_steps: " + steps,
+                                               "planner_steps_" + steps + ".yaml");
+  EXPECT_FALSE(path.empty()) << "planner.yaml has no max_search_steps, or it is " << steps << " already";
   return path;
 }
 
