@@ -425,6 +425,8 @@ void god_bins_of_image(const cv::Mat& image, int s, double flat_mgod_max, int B,
 GodParams GodParams::from_config(const Config& c) {
   GodParams p;
   p.gradient_step = c.get_int("gradient_step", 1, 16);
+  p.smoothing_radius_px = c.get_int("smoothing_radius_px", 0, 16);
+  p.smoothing_max_difference = c.get_double("smoothing_max_difference", 0.0, 1e9);
   p.direction_bins = c.get_int("direction_bins", 2, 254);
   p.flat_mgod_max = c.get_double("flat_mgod_max", 0.0, 1e6);
   p.window_size = c.get_int("window_size", 1, 101);
@@ -448,6 +450,8 @@ GodParams GodParams::from_config(const Config& c) {
 
 void GodParams::validate() const {
   if (gradient_step < 1) throw std::invalid_argument("gradient_step must be >= 1");
+  if (smoothing_radius_px < 0) throw std::invalid_argument("smoothing_radius_px must be >= 0");
+  if (!(smoothing_max_difference >= 0.0)) throw std::invalid_argument("smoothing_max_difference must be >= 0");
   if (direction_bins < 2 || direction_bins > 254) throw std::invalid_argument("direction_bins must be in [2, 254]");
   if (window_size < 1 || window_size % 2 == 0) throw std::invalid_argument("window_size must be odd and >= 1");
   if (!(flat_mgod_max >= 0.0)) throw std::invalid_argument("flat_mgod_max must be >= 0");
@@ -456,6 +460,104 @@ void GodParams::validate() const {
   if (adjacency_radius_px < 1) throw std::invalid_argument("adjacency_radius_px must be >= 1");
   if (boundary_growth_px < 0) throw std::invalid_argument("boundary_growth_px must be >= 0");
   if (min_region_px < 1) throw std::invalid_argument("min_region_px must be >= 1");
+}
+
+namespace {
+
+/// Adds to sum[x], count[x] the values v[x] (x in [0, n)) that are valid and within max_difference of
+/// centre[x]. NaN compares false, so an invalid v or centre adds nothing. SSE2 four at a time (the same
+/// float operations per element as the scalar tail, so the result does not depend on the path).
+inline void add_close_values(const float* __restrict v, const float* __restrict centre, int n,
+                             float max_difference, float* __restrict sum, float* __restrict count) {
+  constexpr float kInf = std::numeric_limits<float>::infinity();
+  int x = 0;
+#if defined(__SSE2__)
+  const __m128 zero = _mm_setzero_ps(), inf = _mm_set1_ps(kInf), one = _mm_set1_ps(1.f);
+  const __m128 dmax = _mm_set1_ps(max_difference), abs_mask = _mm_castsi128_ps(_mm_set1_epi32(0x7fffffff));
+  for (; x + 4 <= n; x += 4) {
+    const __m128 value = _mm_loadu_ps(v + x);
+    const __m128 diff = _mm_and_ps(_mm_sub_ps(value, _mm_loadu_ps(centre + x)), abs_mask);
+    const __m128 use = _mm_and_ps(_mm_and_ps(_mm_cmpgt_ps(value, zero), _mm_cmplt_ps(value, inf)),
+                                  _mm_cmple_ps(diff, dmax));
+    _mm_storeu_ps(sum + x, _mm_add_ps(_mm_loadu_ps(sum + x), _mm_and_ps(use, value)));
+    _mm_storeu_ps(count + x, _mm_add_ps(_mm_loadu_ps(count + x), _mm_and_ps(use, one)));
+  }
+#endif
+  for (; x < n; ++x) {
+    const float value = v[x];
+    if (value > 0.f && value < kInf && std::fabs(value - centre[x]) <= max_difference) {
+      sum[x] += value;
+      count[x] += 1.f;
+    }
+  }
+}
+
+/// out[x] = sum[x] / count[x] where centre[x] is valid (count >= 1: the centre itself), else centre[x].
+inline void finish_means(const float* __restrict centre, const float* __restrict sum, const float* __restrict count,
+                         int n, float* __restrict out) {
+  int x = 0;
+#if defined(__SSE2__)
+  const __m128 zero = _mm_setzero_ps(), inf = _mm_set1_ps(std::numeric_limits<float>::infinity());
+  for (; x + 4 <= n; x += 4) {
+    const __m128 c = _mm_loadu_ps(centre + x);
+    const __m128 valid = _mm_and_ps(_mm_cmpgt_ps(c, zero), _mm_cmplt_ps(c, inf));
+    const __m128 mean = _mm_div_ps(_mm_loadu_ps(sum + x), _mm_loadu_ps(count + x));
+    _mm_storeu_ps(out + x, _mm_or_ps(_mm_and_ps(valid, mean), _mm_andnot_ps(valid, c)));
+  }
+#endif
+  for (; x < n; ++x) out[x] = valid_value(centre[x]) ? sum[x] / count[x] : centre[x];
+}
+
+/// The two passes of smooth_valid_values: along rows (each pixel with the pixels within r columns of
+/// it), then along columns (within r rows), each a row at a time into per-column sums.
+void smooth_rows_then_columns(const cv::Mat& in, int r, float max_difference, cv::Mat& rows, cv::Mat& out,
+                              std::vector<float>& sum, std::vector<float>& count) {
+  const int W = in.cols, H = in.rows;
+  rows.create(in.size(), CV_32F);
+  out.create(in.size(), CV_32F);
+  sum.resize(size_t(W));
+  count.resize(size_t(W));
+  for (int y = 0; y < H; ++y) {
+    const float* src = in.ptr<float>(y);
+    std::fill(sum.begin(), sum.end(), 0.f);
+    std::fill(count.begin(), count.end(), 0.f);
+    for (int k = -r; k <= r; ++k) {
+      const int x0 = std::max(0, -k), x1 = std::min(W, W - k);  // x + k within the row
+      if (x1 > x0) add_close_values(src + x0 + k, src + x0, x1 - x0, max_difference, &sum[size_t(x0)], &count[size_t(x0)]);
+    }
+    finish_means(src, sum.data(), count.data(), W, rows.ptr<float>(y));
+  }
+  for (int y = 0; y < H; ++y) {
+    const float* centre = rows.ptr<float>(y);
+    std::fill(sum.begin(), sum.end(), 0.f);
+    std::fill(count.begin(), count.end(), 0.f);
+    for (int k = std::max(0, y - r); k <= std::min(H - 1, y + r); ++k)
+      add_close_values(rows.ptr<float>(k), centre, W, max_difference, sum.data(), count.data());
+    finish_means(centre, sum.data(), count.data(), W, out.ptr<float>(y));
+  }
+}
+
+}  // namespace
+
+namespace {
+
+/// smooth_valid_values into `out` (r >= 1), with the intermediate buffers of this thread.
+void smooth_valid_values_into(const cv::Mat& image, int radius, double max_difference, cv::Mat& out) {
+  thread_local cv::Mat rows;
+  thread_local std::vector<float> sum, count;
+  smooth_rows_then_columns(image, radius, float(max_difference), rows, out, sum, count);
+}
+
+}  // namespace
+
+cv::Mat smooth_valid_values(const cv::Mat& image, int radius, double max_difference) {
+  if (image.type() != CV_32F) throw std::invalid_argument("smooth_valid_values: image must be CV_32F");
+  if (radius < 0) throw std::invalid_argument("smooth_valid_values: radius must be >= 0");
+  if (!(max_difference >= 0.0)) throw std::invalid_argument("smooth_valid_values: max_difference must be >= 0");
+  if (radius == 0) return image.clone();
+  cv::Mat out;
+  smooth_valid_values_into(image, radius, max_difference, out);
+  return out;
 }
 
 GodFeatures compute_god_features(const cv::Mat& image, int s, double flat_mgod_max) {
@@ -987,7 +1089,7 @@ namespace {
 /// usual size reuses the previous frame's memory instead of faulting in fresh pages. Only capacity
 /// carries over: every buffer is sized and initialised per call as before.
 struct GodWorkspace {
-  cv::Mat bins, clusters, labels;
+  cv::Mat bins, clusters, labels, smoothed;
   std::vector<Count> col;
   std::vector<Count8> col8;
   UnionFind cc_uf, uf;
@@ -1031,14 +1133,18 @@ SegmentationResult segment_god(const cv::Mat& image, const cv::Mat& points, cons
   cv::Mat& bins = debug ? dbg.bins : own(ws.bins);
   cv::Mat& clusters = debug ? dbg.clusters : own(ws.clusters);
   cv::Mat& init_labels = debug ? dbg.initial_labels : own(ws.labels);  // without debug: the merged labels' buffer
+  // The gradients' input: the image, or its edge-preserving mean (the planes use the image itself).
+  if (params.smoothing_radius_px > 0)
+    smooth_valid_values_into(image, params.smoothing_radius_px, params.smoothing_max_difference, ws.smoothed);
+  const cv::Mat& gradient_input = params.smoothing_radius_px > 0 ? ws.smoothed : image;
   if (debug) {
-    dbg.features = compute_god_features(image, params.gradient_step, params.flat_mgod_max);
+    dbg.features = compute_god_features(gradient_input, params.gradient_step, params.flat_mgod_max);
     dbg.bins = god_bins(dbg.features, params.direction_bins, params.jump_mgod_min);
     dbg.clusters.release();
     dbg.initial_labels.release();
   } else {
     // Same bins without the DGoD/MGoD images (only the debug output needs them).
-    god_bins_of_image(image, params.gradient_step, params.flat_mgod_max, params.direction_bins, params.jump_mgod_min,
+    god_bins_of_image(gradient_input, params.gradient_step, params.flat_mgod_max, params.direction_bins, params.jump_mgod_min,
                       bins);
   }
   if (params.window_size <= 15)

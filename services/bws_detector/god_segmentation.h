@@ -38,6 +38,12 @@ enum class MergeSpace {
 struct GodParams {
   /// Gradient half-step s: dx = P(y, x+s) - P(y, x-s), dy = P(y+s, x) - P(y-s, x). The paper uses 1.
   int gradient_step = 1;
+  /// Radius r of the smoothing of the image the gradients are taken from (smooth_valid_values);
+  /// 0 = none (the paper). Planes, the merge and the output use the unsmoothed image.
+  int smoothing_radius_px = 0;
+  /// Neighbours whose value differs from the centre's by more than this (image units) are left out of
+  /// the smoothing, so that a jump edge does not become a ramp.
+  double smoothing_max_difference = 1.0;
   /// Number of direction bins B of the voting histogram (the flat bin comes on top).
   int direction_bins = 16;
   /// Pixels with MGoD <= this are "flat" (DGoD = 0); 0 = only exactly zero gradients (the paper).
@@ -87,6 +93,13 @@ struct GodFeatures {
 /// non-finite or <= 0 are invalid. Angles are within 1e-3 deg of atan2 (a
 /// polynomial arctangent); axis directions (0/90/180/270/360) are exact.
 GodFeatures compute_god_features(const cv::Mat& image, int gradient_step, double flat_mgod_max);
+
+/// Edge-preserving mean for the gradients: every valid pixel becomes the mean of the valid pixels of
+/// its (2r+1) x (2r+1) neighbourhood whose value is within `max_difference` of its own (a horizontal
+/// pass, then a vertical one, each with that test against the pass's centre). Invalid pixels (non-finite
+/// or <= 0) stay as they are. A plane stays the same plane away from its border; zero-mean noise of
+/// standard deviation sigma drops to about sigma / (2r+1). r = 0 returns a copy. CV_32F in and out.
+cv::Mat smooth_valid_values(const cv::Mat& image, int radius, double max_difference);
 
 /// Histogram bin of every pixel: 0..B-1 direction, B = flat, 255 = does not vote
 /// (no feature, or MGoD > jump_mgod_min). CV_8U. B must be <= 254.

@@ -24,7 +24,8 @@ struct Input {
   cv::Mat left, right, disparity, points;
   StereoGeometry g;
   DisparityParams dp;
-  GodParams gp;
+  GodParams gp;        // the shipped `god` section
+  GodParams gp_stop33;  // the section shipped until stop 34: no smoothing, 16 bins, 5 x 5 voting (the baseline)
   PclPlaneParams pp, pp_metric;
   SelectionParams sp;
   Input() {
@@ -34,9 +35,9 @@ struct Input {
     g = {scene.left.fx, scene.left.fy, scene.left.cx, scene.left.cy, scene.baseline_m};
     disparity = compute_disparity(left, right, dp);
     points = disparity_to_points(disparity, g);
-    gp.window_size = 5;
-    gp.jump_mgod_min = 0.6;
-    gp.min_region_px = 30;
+    gp_stop33.window_size = 5;
+    gp_stop33.jump_mgod_min = 0.6;
+    gp_stop33.min_region_px = 30;
     pp_metric.min_inliers = 30;  // the metric-space PCL segmentation shipped until 2026-12-02
     pp_metric.normal_smoothing_size = 5.0;
     pp_metric.max_depth_change_factor = 0.01;
@@ -48,6 +49,7 @@ struct Input {
     const std::string dir = std::string(BOOKGRASP_SOURCE_DIR) + "/config/services/";
     pp = PclPlaneParams::from_config(bookgrasp::Config::load_file(dir + "bws_detector_pcl.yaml").child("pcl"));
     sp = SelectionParams::from_config(bookgrasp::Config::load_file(dir + "bws_detector.yaml").child("selection"));
+    gp = GodParams::from_config(bookgrasp::Config::load_file(dir + "bws_detector.yaml").child("god"));
   }
 };
 Input& input() {
@@ -68,17 +70,34 @@ static void BM_GodFeatures(benchmark::State& s) {
 }
 BENCHMARK(BM_GodFeatures)->Unit(benchmark::kMillisecond);
 
-static void BM_GodSegmentation(benchmark::State& s) {
+static void BM_GodSmoothing(benchmark::State& s) {
+  auto& in = input();
+  for (auto _ : s)
+    benchmark::DoNotOptimize(
+        smooth_valid_values(in.disparity, in.gp.smoothing_radius_px, in.gp.smoothing_max_difference));
+}
+BENCHMARK(BM_GodSmoothing)->Unit(benchmark::kMillisecond);
+
+static void god_segmentation(benchmark::State& s, const GodParams& gp) {
   auto& in = input();
   GodDebug dbg;  // counters from one run with debug output; the timed runs are the pipeline's (no debug)
-  segment_god(in.disparity, in.points, in.gp, &dbg);
+  segment_god(in.disparity, in.points, gp, &dbg);
   const double f0 = minor_faults();
-  for (auto _ : s) benchmark::DoNotOptimize(segment_god(in.disparity, in.points, in.gp));
+  for (auto _ : s) benchmark::DoNotOptimize(segment_god(in.disparity, in.points, gp));
   s.counters["faults"] = benchmark::Counter((minor_faults() - f0) / double(s.iterations()));
   s.counters["initial_segments"] = dbg.initial_count;
   s.counters["merge_rounds"] = dbg.merge_rounds;
 }
+/// GoD with the shipped parameters (smoothing included).
+static void BM_GodSegmentation(benchmark::State& s) {
+  god_segmentation(s, input().gp);
+}
+/// GoD with the parameters shipped until stop 34 (the named baseline).
+static void BM_GodSegmentation_Stop33Params(benchmark::State& s) {
+  god_segmentation(s, input().gp_stop33);
+}
 BENCHMARK(BM_GodSegmentation)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_GodSegmentation_Stop33Params)->Unit(benchmark::kMillisecond);
 
 static void BM_BookFrontSelection(benchmark::State& s) {
   auto& in = input();

@@ -235,6 +235,68 @@ TEST(SegmentGod, MergeSpacePointsUsesTheCallersUnits) {
   EXPECT_THROW(segment_god(img, cv::Mat(), p), std::invalid_argument);
 }
 
+TEST(SmoothValidValues, KeepsAPlaneAndAJumpAndCutsNoiseByTheWindow) {
+  // A plane stays itself away from the border.
+  const cv::Mat plane = affine_image(40, 30, 0.2, -0.05, 30.0);
+  const cv::Mat sp = smooth_valid_values(plane, 2, 1.0);
+  for (int y = 2; y < 28; ++y)
+    for (int x = 2; x < 38; ++x) ASSERT_NEAR(sp.at<float>(y, x), plane.at<float>(y, x), 1e-4) << x << "," << y;
+  // A jump larger than max_difference stays a jump: each side averages only itself (flat sides: exact).
+  cv::Mat step(20, 40, CV_32F);
+  for (int y = 0; y < 20; ++y)
+    for (int x = 0; x < 40; ++x) step.at<float>(y, x) = x < 20 ? 10.f : 12.f;
+  const cv::Mat ss = smooth_valid_values(step, 3, 1.0);
+  EXPECT_EQ(cv::countNonZero(ss != step), 0);
+  // Below max_difference the step is averaged: a ramp (this is what the limit is for).
+  EXPECT_GT(smooth_valid_values(step, 3, 5.0).at<float>(10, 19), 10.5f);
+  // Zero-mean noise drops to about sigma / (2r+1) (two passes of 2r+1 samples: (2r+1)^2 in all).
+  cv::Mat noisy = affine_image(200, 200, 0.01, 0.02, 40.0);
+  cv::RNG rng(7);
+  for (int y = 0; y < 200; ++y)
+    for (int x = 0; x < 200; ++x) noisy.at<float>(y, x) += float(rng.gaussian(0.1));
+  const cv::Mat sn = smooth_valid_values(noisy, 2, 1.0);
+  const cv::Mat truth = affine_image(200, 200, 0.01, 0.02, 40.0);
+  double ss_err = 0;
+  int n = 0;
+  for (int y = 5; y < 195; ++y)
+    for (int x = 5; x < 195; ++x, ++n) ss_err += std::pow(sn.at<float>(y, x) - truth.at<float>(y, x), 2);
+  EXPECT_NEAR(std::sqrt(ss_err / n), 0.1 / 5.0, 0.004);
+  // r = 0 is a copy.
+  EXPECT_EQ(cv::countNonZero(smooth_valid_values(noisy, 0, 1.0) != noisy), 0);
+}
+
+TEST(SmoothValidValues, InvalidPixelsStayAndAreLeftOut) {
+  cv::Mat img(10, 10, CV_32F, cv::Scalar(20.f));
+  img.at<float>(5, 5) = kNaN;
+  img.at<float>(2, 2) = 0.f;
+  img.at<float>(7, 3) = -1.f;
+  img.at<float>(4, 5) = 21.f;  // valid, within max_difference of its neighbours
+  const cv::Mat s = smooth_valid_values(img, 1, 2.0);
+  EXPECT_TRUE(std::isnan(s.at<float>(5, 5)));
+  EXPECT_EQ(s.at<float>(2, 2), 0.f);
+  EXPECT_EQ(s.at<float>(7, 3), -1.f);
+  // Row 4 first: (20 + 21 + 20) / 3 at column 5. Then column 5: rows 3 and 4; row 5 is the NaN, left out.
+  EXPECT_NEAR(s.at<float>(4, 5), (20.f + 61.f / 3.f) / 2.f, 1e-4f);
+  EXPECT_NEAR(s.at<float>(8, 8), 20.f, 1e-6f);
+  for (int y = 0; y < 10; ++y)
+    for (int x = 0; x < 10; ++x) {
+      const float v = s.at<float>(y, x);
+      if (std::isfinite(v) && v > 0.f) {
+        ASSERT_GE(v, 20.f) << "an invalid value (0, -1) was averaged in at " << x;
+      }
+    }
+}
+
+TEST(SmoothValidValues, BadArgumentsAreRejectedWithAMessage) {
+  const cv::Mat img(5, 5, CV_32F, cv::Scalar(1.f));
+  EXPECT_THROW(smooth_valid_values(cv::Mat(5, 5, CV_8U), 1, 1.0), std::invalid_argument);
+  EXPECT_THROW(smooth_valid_values(img, -1, 1.0), std::invalid_argument);
+  EXPECT_THROW(smooth_valid_values(img, 1, std::nan("")), std::invalid_argument);
+  GodParams p = test_params();
+  p.smoothing_radius_px = -1;
+  EXPECT_THROW(p.validate(), std::invalid_argument);
+}
+
 TEST(SegmentGod, BadInputIsRejectedWithAMessage) {
   GodParams p = test_params();
   EXPECT_THROW(segment_god(cv::Mat(10, 10, CV_8U, cv::Scalar(1)), cv::Mat(), p), std::invalid_argument);
