@@ -467,8 +467,8 @@ namespace {
 /// Adds to sum[x], count[x] the values v[x] (x in [0, n)) that are valid and within max_difference of
 /// centre[x]. NaN compares false, so an invalid v or centre adds nothing. SSE2 four at a time (the same
 /// float operations per element as the scalar tail, so the result does not depend on the path).
-inline void add_close_values(const float* __restrict v, const float* __restrict centre, int n,
-                             float max_difference, float* __restrict sum, float* __restrict count) {
+inline void add_close_values(const float* __restrict v, const float* __restrict centre, int n, float max_difference,
+                             float* __restrict sum, float* __restrict count) {
   constexpr float kInf = std::numeric_limits<float>::infinity();
   int x = 0;
 #if defined(__SSE2__)
@@ -477,8 +477,8 @@ inline void add_close_values(const float* __restrict v, const float* __restrict 
   for (; x + 4 <= n; x += 4) {
     const __m128 value = _mm_loadu_ps(v + x);
     const __m128 diff = _mm_and_ps(_mm_sub_ps(value, _mm_loadu_ps(centre + x)), abs_mask);
-    const __m128 use = _mm_and_ps(_mm_and_ps(_mm_cmpgt_ps(value, zero), _mm_cmplt_ps(value, inf)),
-                                  _mm_cmple_ps(diff, dmax));
+    const __m128 use =
+        _mm_and_ps(_mm_and_ps(_mm_cmpgt_ps(value, zero), _mm_cmplt_ps(value, inf)), _mm_cmple_ps(diff, dmax));
     _mm_storeu_ps(sum + x, _mm_add_ps(_mm_loadu_ps(sum + x), _mm_and_ps(use, value)));
     _mm_storeu_ps(count + x, _mm_add_ps(_mm_loadu_ps(count + x), _mm_and_ps(use, one)));
   }
@@ -523,7 +523,8 @@ void smooth_rows_then_columns(const cv::Mat& in, int r, float max_difference, cv
     std::fill(count.begin(), count.end(), 0.f);
     for (int k = -r; k <= r; ++k) {
       const int x0 = std::max(0, -k), x1 = std::min(W, W - k);  // x + k within the row
-      if (x1 > x0) add_close_values(src + x0 + k, src + x0, x1 - x0, max_difference, &sum[size_t(x0)], &count[size_t(x0)]);
+      if (x1 > x0)
+        add_close_values(src + x0 + k, src + x0, x1 - x0, max_difference, &sum[size_t(x0)], &count[size_t(x0)]);
     }
     finish_means(src, sum.data(), count.data(), W, rows.ptr<float>(y));
   }
@@ -1144,8 +1145,8 @@ SegmentationResult segment_god(const cv::Mat& image, const cv::Mat& points, cons
     dbg.initial_labels.release();
   } else {
     // Same bins without the DGoD/MGoD images (only the debug output needs them).
-    god_bins_of_image(gradient_input, params.gradient_step, params.flat_mgod_max, params.direction_bins, params.jump_mgod_min,
-                      bins);
+    god_bins_of_image(gradient_input, params.gradient_step, params.flat_mgod_max, params.direction_bins,
+                      params.jump_mgod_min, bins);
   }
   if (params.window_size <= 15)
     vote_clusters_into(bins, params.direction_bins + 1, params.window_size, clusters, ws.col8);

@@ -24,7 +24,7 @@ struct Input {
   cv::Mat left, right, disparity, points;
   StereoGeometry g;
   DisparityParams dp;
-  GodParams gp;        // the shipped `god` section
+  GodParams gp;         // the shipped `god` section
   GodParams gp_stop33;  // the section shipped until stop 34: no smoothing, 16 bins, 5 x 5 voting (the baseline)
   PclPlaneParams pp, pp_metric;
   SelectionParams sp;
