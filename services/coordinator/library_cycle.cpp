@@ -952,7 +952,7 @@ void LibraryCycle::fail(const std::string& reason) {
                             " times (retries.max_step_retries), last: " + reason;
     step_retries_ = 0;
     retrying_ = CycleState::kStart;
-    if (state_ == CycleState::kMoveToLowerShelf)
+    if (in(state_, {CycleState::kMoveToLowerShelf, CycleState::kPlaceOnLowerShelf}))
       return_to_holder(why);  // the lower shelf cannot take the book
     else if (progress_.place == BookPlace::kOnHolder)
       leave_on_holder(why);  // the book cannot be taken from the holder again
@@ -964,8 +964,12 @@ void LibraryCycle::fail(const std::string& reason) {
   step_retries_ += 1;
   message_ = "retry " + std::to_string(step_retries_) + " of " + cycle_state_name(state_) + " after: " + reason;
   // A missed grasp on the holder: straight out (the planner does not plan from between the holder's plates:
-  // "start is in collision", the deployed demo's third book), then come back from the pre-grasp pose.
-  const CycleState again = state_ == CycleState::kGraspFromHolder ? CycleState::kBackOutFromHolder : state_;
+  // "start is in collision", the deployed demo's third book), then come back from the pre-grasp pose. A place on
+  // the lower shelf that stopped (a joint limit on the straight move, far_cart seed 5005) is planned again from the
+  // pre-place: the same straight move from where it stopped would stop there again.
+  CycleState again = state_;
+  if (state_ == CycleState::kGraspFromHolder) again = CycleState::kBackOutFromHolder;
+  if (state_ == CycleState::kPlaceOnLowerShelf) again = CycleState::kMoveToLowerShelf;
   enter(again);
 }
 
