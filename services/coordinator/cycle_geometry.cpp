@@ -85,6 +85,7 @@ CycleGeometry CycleGeometry::from_config(const Config& c) {
   if (g.lower_first_right_y <= g.lower_left_y)
     throw ConfigError(c.source() + ": " + c.path_of("lower_shelf.first_right_y_m") + " must be right of " +
                       c.path_of("lower_shelf.left_y_m"));
+  g.lower_retry_shift = c.get_double("lower_shelf.retry_shift_m", 0.0, 0.2);
   g.lower_pre_place_offset = vec3(c, "lower_shelf.pre_place_offset_m", 1.0);
   g.lower_retreat = c.get_double("lower_shelf.retreat_m", 0.02, 1.0);
   g.lower_place_guard = c.get_double("lower_shelf.place_guard_m", 0.0, 0.1);

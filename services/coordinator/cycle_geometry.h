@@ -96,6 +96,9 @@ struct CycleGeometry {
   /// swings the right plate into the book placed before.
   double lower_release_opening = 0.0;
   double lower_left_y = -0.40;      ///< inner left end of the lower shelf, grasp Y
+  /// Not in the paper: a place on the lower shelf that stopped (a joint limit on its straight move) is tried again
+  /// this much further left (grasp Y), where the arm reaches further down; 0 = the same slot again.
+  double lower_retry_shift = 0.0;
   Eigen::Vector3d lower_pre_place_offset = Eigen::Vector3d::Zero();  ///< pre-place = place + this (grasp)
   double lower_retreat = 0.30;      ///< after release, out along -Z
   double lower_shelf_gap = 0.0;     ///< free height between the lower shelf and the upper one's underside (0 = unused)

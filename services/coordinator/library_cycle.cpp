@@ -658,6 +658,9 @@ void LibraryCycle::book_done(bool handed_over) {
   progress_.books_moved += 1;
   if (!handed_over)
     progress_.lower_next_right_y = next_lower_right_y(progress_.lower_next_right_y, progress_.book_width, g);
+  else
+    progress_.lower_next_right_y += lower_slot_shift_;  // the slot this book tried first, for the next one
+  lower_slot_shift_ = 0.0;
   progress_.place = BookPlace::kUpperShelf;
   progress_.have_book_data = false;
   progress_.hand_over_reason.clear();
@@ -969,7 +972,17 @@ void LibraryCycle::fail(const std::string& reason) {
   // pre-place: the same straight move from where it stopped would stop there again.
   CycleState again = state_;
   if (state_ == CycleState::kGraspFromHolder) again = CycleState::kBackOutFromHolder;
-  if (state_ == CycleState::kPlaceOnLowerShelf) again = CycleState::kMoveToLowerShelf;
+  if (state_ == CycleState::kPlaceOnLowerShelf) {
+    again = CycleState::kMoveToLowerShelf;
+    // Further left the arm reaches further down (the planner's "no goal solution from which the straight moves stay
+    // within the joint limits" at base y -0.20, seed 5005); a slot left of the shelf's end hands the book over.
+    if (s_.geometry.lower_retry_shift > 0) {
+      progress_.lower_next_right_y -= s_.geometry.lower_retry_shift;
+      lower_slot_shift_ += s_.geometry.lower_retry_shift;
+      progress_changed_ = true;
+      message_ += "; the slot moves " + mm(s_.geometry.lower_retry_shift) + " left";
+    }
+  }
   enter(again);
 }
 

@@ -385,6 +385,10 @@ class LibraryCycle {
   std::vector<CycleRequest> out_;
   int attempt_ = 1;
   int step_retries_ = 0;
+  /// How far (grasp Y) the current book's lower-shelf slot was moved left by retries of its place
+  /// (geometry.lower_retry_shift); given back when the book is handed over instead. Not persisted: a coordinator
+  /// restarted in between keeps the moved slot for the next book.
+  double lower_slot_shift_ = 0.0;
   /// The step whose failure the retries count (kStart = none). Only its own success resets step_retries_: a retry of
   /// GRASP_FROM_HOLDER passes through BACK_OUT_FROM_HOLDER .. APPROACH_HOLDER, whose successes must not reset it.
   CycleState retrying_ = CycleState::kStart;

@@ -613,6 +613,7 @@ TEST(LibraryCycle, BadDepthKeysNameTheKey) {
         {"grasp.width_left_clearance_m", "width_left_clearance_m: 0.005", "width_left_clearance_m: 0.2"},
         {"holder.regrasp_min_height_m", "regrasp_min_height_m: 0.15", "regrasp_min_height_m: -0.1"},
         {"lower_shelf.release_opening_m", "release_opening_m: 0.006 ", "release_opening_m: 0.1 "},
+        {"lower_shelf.retry_shift_m", "retry_shift_m: 0.03 ", "retry_shift_m: -0.03 "},
         // The 6 mm release opening with a 5 mm gap: the right plate would push the book placed before over.
         {"lower_shelf.gap_m", "gap_m: 0.022 ", "gap_m: 0.005 "},
         {"planning.placed_books_as_obstacles", "placed_books_as_obstacles: true", "placed_books_as_obstacles: 0.3"},
@@ -860,47 +861,70 @@ TEST(LibraryCycle, APlaceThatAJointLimitStopsRightAboveThePoseIsDone) {
     free_world.run(cycle, [&] { return cycle.progress().books_moved >= 1 || done_or_aborted(cycle); });
     ASSERT_EQ(free_world.lower.size(), 1u);
   }
-  const Eigen::Isometry3d place = free_world.lower[0].second;
-  // The driver stops the place on the lower shelf 3 mm before its pose (within limit_stop_place_m): placed;
-  // 2.5 cm before (beyond it, though within the stall guard): the place fails, is planned again from the pre-place
-  // (the same straight move from where it stopped would stop there again), and when it keeps stopping, the book
-  // goes back onto the holder for the librarian (far_cart seed 5005 aborted with the book in the plates).
-  for (const double before : {0.003, 0.025}) {
-    SCOPED_TRACE("stopped " + std::to_string(before) + " m before");
+  const Eigen::Vector3d place = free_world.lower[0].second.translation();
+  const CycleSettings s = settings();
+  ASSERT_GT(s.limit_stop_place, 0.003);
+  ASSERT_LT(s.limit_stop_place, 0.025);
+  ASSERT_GT(s.geometry.lower_place_guard, 0.025);
+  ASSERT_EQ(s.max_step_retries, 2);
+  ASSERT_TRUE(s.hand_over_unplaceable);
+  ASSERT_GT(s.geometry.lower_retry_shift, 0.025);
+  // The grasp frame's Y in base (the fake cart stands square: grasp Y along base -Y or +Y).
+  const Eigen::Vector3d grasp_y = hand_grasp_frame().linear().col(1);
+  // The driver stops the place on the lower shelf 3 mm before its pose (within limit_stop_place_m): placed there.
+  {
     FakeLibrary w(three_books());
-    w.limit_near["PLACE_ON_LOWER_SHELF"] = {place.translation(), before};
-    const CycleSettings s = settings();
-    ASSERT_GT(s.limit_stop_place, 0.003);
-    ASSERT_LT(s.limit_stop_place, 0.025);
-    ASSERT_GT(s.geometry.lower_place_guard, 0.025);
-    ASSERT_EQ(s.max_step_retries, 2);
-    ASSERT_TRUE(s.hand_over_unplaceable);
+    w.limit_near["PLACE_ON_LOWER_SHELF"] = {place, 0.003};
+    LibraryCycle cycle(s, std::nullopt);
+    w.run(cycle, [&] { return cycle.progress().books_moved >= 1 || done_or_aborted(cycle); });
+    EXPECT_EQ(cycle.progress().books_moved, 1) << cycle.status().message;
+    EXPECT_EQ(cycle.progress().failures, 0);
+    ASSERT_EQ(w.lower.size(), 1u);
+    EXPECT_NEAR((w.lower[0].second.translation() - place).norm(), 0.003, 1e-3);
+  }
+  // 2.5 cm before (beyond limit_stop_place_m, within the stall guard): the place failed. It is planned again from the
+  // pre-place (the same straight move from where it stopped would stop there again), lower_shelf.retry_shift_m
+  // further left, where this limit is not met: placed there (far_cart seed 5005, arm_2's limit at the first slot).
+  {
+    FakeLibrary w(three_books());
+    w.limit_near["PLACE_ON_LOWER_SHELF"] = {place, 0.025};
+    LibraryCycle cycle(s, std::nullopt);
+    w.run(cycle, [&] { return cycle.progress().books_moved >= 1 || done_or_aborted(cycle); });
+    EXPECT_EQ(cycle.progress().books_moved, 1) << cycle.status().message;
+    EXPECT_EQ(cycle.progress().failures, 1);
+    EXPECT_EQ(slice(w.states, "PLACE_ON_LOWER_SHELF", 3),
+              (std::vector<std::string>{"PLACE_ON_LOWER_SHELF", "MOVE_TO_LOWER_SHELF", "PLACE_ON_LOWER_SHELF"}));
+    ASSERT_EQ(w.lower.size(), 1u);
+    const Eigen::Vector3d moved = w.lower[0].second.translation() - place;
+    EXPECT_NEAR(moved.dot(grasp_y), -s.geometry.lower_retry_shift, 1e-3) << "further left in the grasp frame";
+    EXPECT_NEAR((moved - moved.dot(grasp_y) * grasp_y).norm(), 0.0, 1e-3);
+    ASSERT_EQ(cycle.progress().moved.size(), 1u);
+    EXPECT_FALSE(cycle.progress().moved[0].handed_over);
+  }
+  // A limit that stops every place within 8 cm of the first slot: 3 tries (the first slot, 3 and 6 cm left), then
+  // the book goes back onto the holder for the librarian instead of an abort with the book in the plates.
+  {
+    FakeLibrary w(three_books());
+    w.limit_near["PLACE_ON_LOWER_SHELF"] = {place, 0.08};
     LibraryCycle cycle(s, std::nullopt);
     w.run(cycle, [&] {
       return cycle.progress().books_moved >= 1 || done_or_aborted(cycle) || cycle.state() == CycleState::kWaitBookTaken;
     });
-    if (before < s.limit_stop_place) {
-      EXPECT_EQ(cycle.progress().books_moved, 1) << cycle.status().message;
-      EXPECT_EQ(cycle.progress().failures, 0);
-      ASSERT_EQ(w.lower.size(), 1u);
-      EXPECT_NEAR((w.lower[0].second.translation() - place.translation()).norm(), before, 1e-3);
-    } else {
-      ASSERT_EQ(cycle.state(), CycleState::kWaitBookTaken) << cycle.status().message;
-      EXPECT_NE(cycle.progress().hand_over_reason.find("PLACE_ON_LOWER_SHELF failed 3 times"), std::string::npos)
-          << cycle.progress().hand_over_reason;
-      EXPECT_NE(cycle.progress().hand_over_reason.find("limit of joint arm_2_joint"), std::string::npos)
-          << cycle.progress().hand_over_reason;
-      w.run(cycle, [&] { return cycle.progress().books_moved >= 1 || done_or_aborted(cycle); });
-      EXPECT_EQ(cycle.progress().failures, 3);
-      EXPECT_EQ(count(w.states, "PLACE_ON_LOWER_SHELF"), 3) << "1 try + 2 retries";
-      EXPECT_EQ(count(w.states, "MOVE_TO_LOWER_SHELF"), 3) << "each retry planned again from the pre-place";
-      EXPECT_EQ(slice(w.states, "PLACE_ON_LOWER_SHELF", 2),
-                (std::vector<std::string>{"PLACE_ON_LOWER_SHELF", "MOVE_TO_LOWER_SHELF"}));
-      EXPECT_TRUE(w.lower.empty());
-      ASSERT_EQ(w.taken_by_librarian.size(), 1u) << "back on the holder, then taken by the librarian";
-      ASSERT_EQ(cycle.progress().moved.size(), 1u);
-      EXPECT_TRUE(cycle.progress().moved[0].handed_over);
-    }
+    ASSERT_EQ(cycle.state(), CycleState::kWaitBookTaken) << cycle.status().message;
+    EXPECT_NE(cycle.progress().hand_over_reason.find("PLACE_ON_LOWER_SHELF failed 3 times"), std::string::npos)
+        << cycle.progress().hand_over_reason;
+    EXPECT_NE(cycle.progress().hand_over_reason.find("limit of joint arm_2_joint"), std::string::npos)
+        << cycle.progress().hand_over_reason;
+    w.run(cycle, [&] { return cycle.progress().books_moved >= 1 || done_or_aborted(cycle); });
+    EXPECT_EQ(cycle.progress().failures, 3);
+    EXPECT_EQ(count(w.states, "PLACE_ON_LOWER_SHELF"), 3) << "1 try + 2 retries";
+    EXPECT_EQ(count(w.states, "MOVE_TO_LOWER_SHELF"), 3) << "each retry planned again from the pre-place";
+    EXPECT_TRUE(w.lower.empty());
+    ASSERT_EQ(w.taken_by_librarian.size(), 1u) << "back on the holder, then taken by the librarian";
+    ASSERT_EQ(cycle.progress().moved.size(), 1u);
+    EXPECT_TRUE(cycle.progress().moved[0].handed_over);
+    EXPECT_NEAR(cycle.progress().lower_next_right_y, s.geometry.lower_first_right_y, 1e-9)
+        << "the next book gets the slot this one tried first";
   }
 }
 
