@@ -538,10 +538,6 @@ void smooth_rows_then_columns(const cv::Mat& in, int r, float max_difference, cv
   }
 }
 
-}  // namespace
-
-namespace {
-
 /// smooth_valid_values into `out` (r >= 1), with the intermediate buffers of this thread.
 void smooth_valid_values_into(const cv::Mat& image, int radius, double max_difference, cv::Mat& out) {
   thread_local cv::Mat rows;
