@@ -159,8 +159,12 @@ void accumulate(const SceneOutcome& o, int max_books, const MetricTolerances& to
   m->grasp_successes += r.grasp_successes;
   m->holder_releases += r.holder_releases;
   m->holder_placed += r.holder_placed;
-  for (const auto& b : r.books) m->holder_retreats += b.standing_on_holder >= 0 ? 1 : 0;
-  m->holder_standing += r.holder_standing;
+  // Per book (its last retreat from the holder), as the denominator: a book that goes back onto the holder for the
+  // librarian retreats twice, and r.holder_standing counts both.
+  for (const auto& b : r.books) {
+    m->holder_retreats += b.standing_on_holder >= 0 ? 1 : 0;
+    m->holder_standing += b.standing_on_holder == 1 ? 1 : 0;
+  }
   for (const auto& d : r.decisions) {
     if (d.truth_known)
       for (int k = 0; k < 3; ++k) {

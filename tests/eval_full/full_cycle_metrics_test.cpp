@@ -122,6 +122,32 @@ TEST(FullCycleMetrics, AHandedOverBookIsCountedApartAndNamedOnlyWhenNothingElseF
   EXPECT_EQ(failure_reason(o.result, 0), "BOOK_NOT_ON_LOWER_SHELF at the end: the book is other");
 }
 
+// A book the lower shelf could not take goes back onto the holder: two retreats from the holder, both with the book
+// standing (the harness's scene count is 3 for the two books). The rate counts books, as its denominator does: 2 of
+// 2, not 3 of 2 (seeds 5000-5099 at stop 34 read 1.0101).
+TEST(FullCycleMetrics, ABookBackOnTheHolderCountsOnceInTheStandingRate) {
+  SceneOutcome o = done_scene(5);
+  o.result.books[0].handed_over = o.result.books[0].handed_over_unplaceable = true;
+  o.result.final_truth.books[0].place = "other";
+  o.result.holder_releases = 3;
+  o.result.holder_placed = 3;
+  o.result.holder_standing = 3;
+  ASSERT_EQ(o.result.books.size(), 3u);  // the third record is a close on nothing: never on the holder
+  ASSERT_EQ(o.result.books[0].standing_on_holder, 1);
+  ASSERT_EQ(o.result.books[1].standing_on_holder, 1);
+  ASSERT_EQ(o.result.books[2].standing_on_holder, -1);
+  EvalMetrics m;
+  accumulate(o, 0, MetricTolerances{}, &m);
+  EXPECT_EQ(m.holder_retreats, 2);
+  EXPECT_EQ(m.holder_standing, 2);
+  EXPECT_NE(metrics_json(m, "cmd").find("\"holder_standing_rate\": 1,"), std::string::npos) << metrics_json(m, "cmd");
+  // A book lying on the holder after its last retreat is not standing.
+  o.result.books[0].standing_on_holder = 0;
+  EvalMetrics m2;
+  accumulate(o, 0, MetricTolerances{}, &m2);
+  EXPECT_EQ(m2.holder_standing, 1);
+}
+
 TEST(FullCycleMetrics, FailureReasons) {
   FullCycleResult r;
   r.end = "ERROR";
