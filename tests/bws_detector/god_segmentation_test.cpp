@@ -467,6 +467,17 @@ TEST(SegmentGod, EqualsAStraightforwardReferenceBitForBit) {
   EXPECT_GT(dbg.merges, 100);
   expect_same(fast, reference_god(d, pts, p), "image space");
   expect_same(segment_god(d, pts, p), fast, "without debug output");
+  {
+    // The smoothed gradients' input: the debug path (DGoD/MGoD images, then bins) and the pipeline's (bins straight
+    // from the image) give the same segmentation, and it is not the unsmoothed one.
+    GodParams sp = p;
+    sp.smoothing_radius_px = 2;
+    sp.smoothing_max_difference = 0.3;
+    GodDebug sdbg;
+    const SegmentationResult smoothed = segment_god(d, pts, sp, &sdbg);
+    expect_same(segment_god(d, pts, sp), smoothed, "smoothed, without debug output");
+    EXPECT_LT(sdbg.initial_count, dbg.initial_count);
+  }
   p.adjacency_radius_px = 1;
   p.window_size = 3;
   p.boundary_growth_px = 3;
