@@ -27,11 +27,17 @@ SelectionParams SelectionParams::from_config(const Config& c) {
   p.split_wide_fronts = c.get<bool>("split_wide_fronts");
   p.split_top_jump_px = c.get_int("split_top_jump_px", 1, 1000);
   p.split_depth_step_m = c.get_double("split_depth_step_m", 0.0, 1.0);
-  p.top_growth_px = c.get_int("top_growth_px", 0, 1000);
-  p.top_growth_disparity_px = c.get_double("top_growth_disparity_px", 0.0, 100.0);
-  p.top_growth_max_gap_px = c.get_int("top_growth_max_gap_px", 0, 1000);
-  p.top_growth_columns = c.get_int("top_growth_columns", 1, 1000);
-  p.top_growth_climbed_only = c.get<bool>("top_growth_climbed_only");
+  TopGrowthParams& t = p.top_growth;
+  t.max_px = c.get_int("top_growth_px", 0, 1000);
+  t.disparity_px = c.get_double("top_growth_disparity_px", 0.0, 100.0);
+  t.max_gap_px = c.get_int("top_growth_max_gap_px", 0, 1000);
+  t.max_hole_px = c.get_int("top_growth_max_hole_px", -1, 1000);
+  t.columns = c.get_int("top_growth_columns", 1, 1000);
+  t.climbed_only = c.get<bool>("top_growth_climbed_only");
+  p.layer_disparity_px = c.get_double("layer_disparity_px", 0.0, 100.0);
+  p.layer_min_rows = c.get_int("layer_min_rows", 1, 10000);
+  p.layer_min_columns = c.get_int("layer_min_columns", 1, 10000);
+  p.layer_min_shift_px = c.get_int("layer_min_shift_px", 0, 10000);
   p.edge_fattening_px = c.get_double("edge_fattening_px", 0.0, 100.0);
   p.pi_rule =
       c.get_choice("pi_rule", {"paper", "right_column_top"}) == "paper" ? PiRule::kPaper : PiRule::kRightColumnTop;
@@ -97,39 +103,45 @@ cv::Point right_column_top(const cv::Mat& labels, int label) {
 }
 
 cv::Point raise_to_plane_top(const cv::Mat& labels, int label, cv::Point pi, const cv::Mat& points_camera,
-                             const Eigen::Vector3d& normal, double offset, const StereoGeometry& g, double tolerance_px,
-                             int max_px, int max_gap_px, int columns, bool climbed_only) {
+                             const Eigen::Vector3d& normal, double offset, const StereoGeometry& g,
+                             const TopGrowthParams& t) {
   if (labels.type() != CV_32S || points_camera.type() != CV_32FC3 || points_camera.size() != labels.size())
     throw std::invalid_argument("raise_to_plane_top: CV_32S labels and CV_32FC3 points of one size expected");
   const double fb = g.fx * g.baseline_m;
   std::vector<int> tops, climbed;
-  for (int x = pi.x; x > pi.x - columns && x >= 0; --x) {
+  for (int x = pi.x; x > pi.x - t.columns && x >= 0; --x) {
     int top = -1;
     for (int y = 0; y < labels.rows && top < 0; ++y)
       if (labels.at<int>(y, x) == label) top = y;
     if (top < 0) continue;
-    int gap = 0;
+    // Rows since the last one on the plane: off it, and without depth.
+    int off = 0, holes = 0;
+    const auto bridged = [&] {
+      return t.max_hole_px < 0 ? off + holes <= t.max_gap_px : off <= t.max_gap_px && holes <= t.max_hole_px;
+    };
     const int start = top;
-    for (int y = start - 1; y >= 0 && start - y <= max_px; --y) {
+    for (int y = start - 1; y >= 0 && start - y <= t.max_px; --y) {
       const cv::Vec3f q = points_camera.at<cv::Vec3f>(y, x);
       if (!std::isfinite(q[2]) || q[2] <= 0.0f) {
-        if (++gap > max_gap_px) break;
+        ++holes;
+        if (!bridged()) break;
         continue;
       }
       const double denom = normal.dot(Eigen::Vector3d((x - g.cx) / g.fx, (y - g.cy) / g.fy, 1.0));
       if (std::fabs(denom) < 1e-9) break;
       const double z_plane = offset / denom;
-      if (!(z_plane > 0.0) || std::fabs(fb / q[2] - fb / z_plane) > tolerance_px) {
-        if (++gap > max_gap_px) break;
+      if (!(z_plane > 0.0) || std::fabs(fb / q[2] - fb / z_plane) > t.disparity_px) {
+        ++off;
+        if (!bridged()) break;
         continue;
       }
       top = y;
-      gap = 0;
+      off = holes = 0;
     }
     tops.push_back(top);
-    if (start - top > max_gap_px) climbed.push_back(top);
+    if (start - top > t.max_gap_px) climbed.push_back(top);
   }
-  if (climbed_only && !climbed.empty()) tops = climbed;
+  if (t.climbed_only && !climbed.empty()) tops = climbed;
   if (tops.empty()) return pi;
   std::nth_element(tops.begin(), tops.begin() + long(tops.size() / 2), tops.end());
   return {pi.x, std::min(pi.y, tops[tops.size() / 2])};
@@ -515,15 +527,88 @@ BookFrontResult select_book_front(const SegmentationResult& seg, const cv::Mat& 
     inside_mask = cv::countNonZero(inside) > 0 ? inside : seg.labels;
     out.pi = corner_of(inside_mask);
   }
-  if (p.top_growth_px > 0)
-    out.pi = raise_to_plane_top(out.split ? band_mask : inside_mask, best, out.pi, points_camera, r.normal, offset, g,
-                                p.top_growth_disparity_px, p.top_growth_px, p.top_growth_max_gap_px,
-                                p.top_growth_columns, p.top_growth_climbed_only);
+  cv::Mat grow_mask = out.split ? band_mask : inside_mask;
+  Eigen::Vector3d normal = r.normal;  // of the plane PI's front lies in (left camera frame)
+  if (p.layer_disparity_px > 0.0) {
+    // The fronts' layer: pixels inside the volume (as `best`) on the plane parallel to the rear board
+    // (the cart's, not the region's normal: a small region's normal can be 15 deg off, which tilts a
+    // plane across the shelf) through the selected front's pixels.
+    const Eigen::Vector3d rear_cam = R.transpose() * rear_n;
+    double layer_offset = offset * rear_cam.dot(r.normal);  // replaced by the pixels' median below
+    {
+      std::vector<double> offs;
+      for (int y = 0; y < seg.labels.rows; ++y) {
+        const int* m = grow_mask.ptr<int>(y);
+        const cv::Vec3f* q = points_camera.ptr<cv::Vec3f>(y);
+        for (int x = 0; x < seg.labels.cols; ++x)
+          if (m[x] == best && point_ok(q[x])) offs.push_back(rear_cam.dot(Eigen::Vector3d(q[x][0], q[x][1], q[x][2])));
+      }
+      if (!offs.empty()) layer_offset = quantile(offs, 0.5);
+    }
+    const double fb = g.fx * g.baseline_m;
+    thread_local cv::Mat layer;
+    layer.create(seg.labels.size(), CV_32S);
+    layer.setTo(cv::Scalar(0));
+    std::vector<int> count(size_t(seg.labels.cols), 0);
+    std::vector<int> first_row(size_t(seg.labels.cols), -1);
+    std::vector<float> high(size_t(seg.labels.cols), -std::numeric_limits<float>::infinity());
+    for (int y = 0; y < seg.labels.rows; ++y) {
+      const cv::Vec3f* q = points_camera.ptr<cv::Vec3f>(y);
+      int* o = layer.ptr<int>(y);
+      for (int x = 0; x < seg.labels.cols; ++x) {
+        if (!point_ok(q[x]) || q[x][2] <= 0.0f) continue;
+        const double dn = rear_cam.dot(Eigen::Vector3d((x - g.cx) / g.fx, (y - g.cy) / g.fy, 1.0));
+        if (std::fabs(dn) < 1e-9 || !(layer_offset / dn > 0.0)) continue;
+        if (std::fabs(fb / q[x][2] - fb * dn / layer_offset) > p.layer_disparity_px) continue;
+        const Eigen::Vector3d qb = cam_in_box * Eigen::Vector3d(q[x][0], q[x][1], q[x][2]);
+        if (!in_volume(qb)) continue;
+        o[x] = best;
+        if (count[size_t(x)]++ == 0) first_row[size_t(x)] = y;
+        high[size_t(x)] = std::max(high[size_t(x)], float(qb.z()));
+      }
+    }
+    // The right-most run of layer_min_columns well-filled columns that reach a book's height above the
+    // volume's floor (the shelf board's top near its front edge lies in the layer too, but low; a side
+    // board can hide a front's lower part), whose tops do not jump more than
+    // split_top_jump_px from column to column (a front's top is level; what lies on the plane beside
+    // the right-most front, as block matching smears it, falls off column by column).
+    int right = -1;
+    for (int x = seg.labels.cols - 1, run = 0; x >= 0 && right < 0; --x) {
+      const size_t i = size_t(x);
+      const bool filled = count[i] >= p.layer_min_rows && high[i] + shelf.half_extent.z() >= p.min_height_m;
+      const bool level = run == 0 || std::abs(first_row[i] - first_row[i + 1]) <= p.split_top_jump_px;
+      run = filled ? (level ? run + 1 : 1) : 0;
+      if (run == p.layer_min_columns) right = x + p.layer_min_columns - 1;
+    }
+    if (right > out.pi.x + p.layer_min_shift_px) {
+      int top = -1;  // its topmost layer pixel with a layer pixel right below
+      for (int y = 0; y + 1 < seg.labels.rows && top < 0; ++y)
+        if (layer.at<int>(y, right) == best && layer.at<int>(y + 1, right) == best) top = y;
+      if (top >= 0) {
+        out.pi = {right, top};
+        out.pi_from_layer = true;
+        grow_mask = layer;
+        // The plane of the front PI now lies on: the layer's normal, the offset of the layer's pixels in
+        // the right-most columns (fronts stand up to a few cm apart in depth).
+        normal = rear_cam;
+        std::vector<double> offs;
+        for (int y = 0; y < seg.labels.rows; ++y)
+          for (int x = std::max(0, right - p.layer_min_columns + 1); x <= right; ++x)
+            if (layer.at<int>(y, x) == best) {
+              const cv::Vec3f& q = points_camera.at<cv::Vec3f>(y, x);
+              offs.push_back(rear_cam.dot(Eigen::Vector3d(q[0], q[1], q[2])));
+            }
+        if (!offs.empty()) offset = quantile(offs, 0.5);
+      }
+    }
+  }
+  if (p.top_growth.max_px > 0)
+    out.pi = raise_to_plane_top(grow_mask, best, out.pi, points_camera, normal, offset, g, p.top_growth);
   // P1's ray: through PI moved edge_fattening_px left and down (StereoBM's border of a near surface
   // in front of a farther one lies that far out; the right-most front's right and top edges are such).
   const Eigen::Vector3d ray((out.pi.x - p.edge_fattening_px - g.cx) / g.fx,
                             (out.pi.y + p.edge_fattening_px - g.cy) / g.fy, 1.0);
-  const double denom = r.normal.dot(ray);
+  const double denom = normal.dot(ray);
   if (std::fabs(denom) > 0.05 * ray.norm()) {
     out.p1_camera = ray * (offset / denom);
   } else {

@@ -48,6 +48,28 @@ enum class PiRule {
   kRightColumnTop,
 };
 
+/// How raise_to_plane_top moves PI up its column to the top of the front's plane (config keys
+/// `selection.top_growth_*`).
+struct TopGrowthParams {
+  /// At most this many rows above the region's top (0 = off).
+  int max_px = 0;
+  /// Agreement of a pixel's disparity with the plane's on its ray, disparity pixels.
+  double disparity_px = 0.3;
+  /// Rows off the plane (StereoBM's outliers, or the book's top face) bridged in a row; also rows without
+  /// depth when max_hole_px is -1.
+  int max_gap_px = 3;
+  /// Rows without stereo depth bridged in a row, counted apart from the rows off the plane: a page face's
+  /// sparse texture leaves StereoBM holes 10-20 rows tall inside a front (docs/BWS.md "Holes in the
+  /// front"). -1 = counted with the rows off the plane, against max_gap_px.
+  int max_hole_px = -1;
+  /// PI's new row is the median of the grown tops of this many columns ending at PI's ...
+  int columns = 3;
+  /// ... of those that climbed more than max_gap_px rows, when any did: a thin front's page face has no
+  /// stereo depth inside its border columns, which then stay at the region's top and outvote the border
+  /// column that follows the front up (docs/BWS.md "The top over the columns that climbed").
+  bool climbed_only = false;
+};
+
 /// Thresholds of the book-front tests (config section `selection`).
 struct SelectionParams {
   /// Max angle between the region normal and the rear-board normal (box x), degrees.
@@ -79,21 +101,21 @@ struct SelectionParams {
   double split_depth_step_m = 0.008;
   /// How PI is found in the selected region or band.
   PiRule pi_rule = PiRule::kRightColumnTop;
-  /// PI then moves up its column over at most this many pixels whose stereo depth agrees with the
-  /// front's plane (raise_to_plane_top; 0 = off): the segmentation often leaves the top of a narrow
-  /// front to a region mixed with the book's top face.
-  int top_growth_px = 0;
-  /// Agreement with the plane for that growth, disparity pixels.
-  double top_growth_disparity_px = 0.3;
-  /// Rows without stereo depth or off the plane (StereoBM's holes and outliers) bridged in a row by that
-  /// growth.
-  int top_growth_max_gap_px = 3;
-  /// PI's new row is the median of the grown tops of this many columns ending at PI's.
-  int top_growth_columns = 3;
-  /// ... of those that climbed more than top_growth_max_gap_px rows, when any did: a thin front's page face
-  /// has no stereo depth inside its border columns, which then stay at the region's top and outvote the
-  /// border column that follows the front up (docs/BWS.md "The top over the columns that climbed").
-  bool top_growth_climbed_only = false;
+  /// How PI then moves up to the top of the front's plane (raise_to_plane_top): the segmentation often
+  /// leaves the top of a narrow front to a region mixed with the book's top face.
+  TopGrowthParams top_growth;
+  /// The front layer (0 = off): after PI is found, the pixels inside the upper-shelf volume whose
+  /// disparity is within this (disparity px) of the selected front's plane are the fronts' layer; when
+  /// its right-most well-filled columns lie right of PI, PI moves to the top of them. The right-most
+  /// front often breaks into regions that each fail the tests while a front further left passes, but
+  /// the fronts stand in one plane (docs/BWS.md "The front layer").
+  double layer_disparity_px = 0.0;
+  /// A layer column counts with at least this many layer pixels ...
+  int layer_min_rows = 15;
+  /// ... and this many such columns side by side ...
+  int layer_min_columns = 2;
+  /// ... and moves PI only when it lies more than this many columns right of PI.
+  int layer_min_shift_px = 3;
   /// P1's viewing ray passes this many pixels left of and below PI: block matching extends a near
   /// surface into a farther background by up to half a block ((block_size - 1) / 2), and the
   /// right-most front's right and top edges border a farther background. 0 = the ray through PI.
@@ -150,6 +172,8 @@ struct BookFrontResult {
   Eigen::Vector3d p1_base = Eigen::Vector3d::Zero();
   /// One verdict per region of the segmentation, in label order.
   std::vector<RegionVerdict> regions;
+  /// True if PI moved right onto the front layer (SelectionParams::layer_disparity_px).
+  bool pi_from_layer = false;
   /// True if the selected book front is a column band of a wider region (see split_wide_fronts);
   /// columns [band_x0, band_x1] of the selected region.
   bool split = false;
@@ -170,17 +194,17 @@ cv::Point upper_right_corner(const cv::Mat& labels, int label, bool* fallback = 
 /// is absent.
 cv::Point right_column_top(const cv::Mat& labels, int label);
 
-/// Moves `pi` up to the top of the front's plane as the stereo depth sees it. In each of `columns`
+/// Moves `pi` up to the top of the front's plane as the stereo depth sees it. In each of `t.columns`
 /// columns ending at pi.x (those holding region pixels), from the column's topmost region pixel, rows
-/// above are taken while the pixel's disparity (fx B / z of `points_camera`) is within `tolerance_px`
+/// above are taken while the pixel's disparity (fx B / z of `points_camera`) is within `t.disparity_px`
 /// of the disparity of the plane { p : normal . p = offset } (left camera frame, metres) on that
-/// pixel's ray, up to `max_gap_px` pixels in a row without depth or off the plane bridged (StereoBM
-/// leaves holes and outliers on a narrow front), at most `max_px` rows; the result keeps pi.x and
-/// takes the median of the columns' tops (never lower than pi.y). With `climbed_only`, the median of the
-/// tops of the columns that climbed more than `max_gap_px` rows, when any did.
+/// pixel's ray, bridging up to `t.max_gap_px` rows in a row off the plane and `t.max_hole_px` without
+/// depth (both counted since the last row on the plane; with -1 the holes count as rows off the plane),
+/// at most `t.max_px` rows. The result keeps pi.x and takes the median of the columns' tops (never lower
+/// than pi.y); see TopGrowthParams for `climbed_only`.
 cv::Point raise_to_plane_top(const cv::Mat& labels, int label, cv::Point pi, const cv::Mat& points_camera,
                              const Eigen::Vector3d& normal, double offset, const StereoGeometry& geometry,
-                             double tolerance_px, int max_px, int max_gap_px, int columns, bool climbed_only = false);
+                             const TopGrowthParams& t);
 
 /// Runs the book-front tests on every region of `segmentation` (planes in the
 /// left camera frame, metres), picks the right-most candidate (smallest base y

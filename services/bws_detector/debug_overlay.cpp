@@ -49,7 +49,9 @@ cv::Mat draw_bws_overlay(const cv::Mat& left, const BwsOutput& r, const std::str
     cv::drawMarker(img, pi, cv::Scalar(255, 255, 0), cv::MARKER_CROSS, 14, 2);
     std::snprintf(buf, sizeof buf, "P1 base [%.3f %.3f %.3f] m, grasp [%.3f %.3f %.3f] m%s", r.selection.p1_base.x(),
                   r.selection.p1_base.y(), r.selection.p1_base.z(), r.p1_grasp.x(), r.p1_grasp.y(), r.p1_grasp.z(),
-                  r.selection.pi_fallback ? " (PI fallback)" : "");
+                  r.selection.pi_fallback     ? " (PI fallback)"
+                  : r.selection.pi_from_layer ? " (PI on the front layer)"
+                                              : "");
     text(buf, cv::Scalar(255, 255, 0));
   } else {
     text("no book: " + r.selection.failure_reason, cv::Scalar(255, 80, 80));

@@ -76,20 +76,33 @@ struct FrontAboveItsRegion {
   }
 };
 
+// raise_to_plane_top on the fixture's region 1 with these growth keys.
+cv::Point grow(const FrontAboveItsRegion& f, cv::Point pi, double disparity_px, int max_px, int max_gap_px, int columns,
+               bool climbed_only = false, int max_hole_px = -1) {
+  TopGrowthParams t;
+  t.disparity_px = disparity_px;
+  t.max_px = max_px;
+  t.max_gap_px = max_gap_px;
+  t.columns = columns;
+  t.climbed_only = climbed_only;
+  t.max_hole_px = max_hole_px;
+  return raise_to_plane_top(f.labels, 1, pi, f.points, f.normal, f.offset, f.g, t);
+}
+
 TEST(RaiseToPlaneTop, ClimbsTheFrontsRowsUpToItsEdge) {
   FrontAboveItsRegion f;
   const cv::Point pi(15, 12);
-  EXPECT_EQ(raise_to_plane_top(f.labels, 1, pi, f.points, f.normal, f.offset, f.g, 0.5, 30, 1, 3), cv::Point(15, 5));
+  EXPECT_EQ(grow(f, pi, 0.5, 30, 1, 3), cv::Point(15, 5));
   // At most max_px rows.
-  EXPECT_EQ(raise_to_plane_top(f.labels, 1, pi, f.points, f.normal, f.offset, f.g, 0.5, 4, 1, 3), cv::Point(15, 8));
+  EXPECT_EQ(grow(f, pi, 0.5, 4, 1, 3), cv::Point(15, 8));
   // One pixel without depth is bridged with max_gap_px 1, two are not (but are with 2).
   f.points.at<cv::Vec3f>(9, 15) = cv::Vec3f(NAN, NAN, NAN);
-  EXPECT_EQ(raise_to_plane_top(f.labels, 1, pi, f.points, f.normal, f.offset, f.g, 0.5, 30, 1, 1), cv::Point(15, 5));
+  EXPECT_EQ(grow(f, pi, 0.5, 30, 1, 1), cv::Point(15, 5));
   f.points.at<cv::Vec3f>(8, 15) = cv::Vec3f(NAN, NAN, NAN);
-  EXPECT_EQ(raise_to_plane_top(f.labels, 1, pi, f.points, f.normal, f.offset, f.g, 0.5, 30, 1, 1), cv::Point(15, 10));
-  EXPECT_EQ(raise_to_plane_top(f.labels, 1, pi, f.points, f.normal, f.offset, f.g, 0.5, 30, 2, 1), cv::Point(15, 5));
+  EXPECT_EQ(grow(f, pi, 0.5, 30, 1, 1), cv::Point(15, 10));
+  EXPECT_EQ(grow(f, pi, 0.5, 30, 2, 1), cv::Point(15, 5));
   // The median of three columns: 15 stops at 10, 14 and 13 reach 5.
-  EXPECT_EQ(raise_to_plane_top(f.labels, 1, pi, f.points, f.normal, f.offset, f.g, 0.5, 30, 1, 3), cv::Point(15, 5));
+  EXPECT_EQ(grow(f, pi, 0.5, 30, 1, 3), cv::Point(15, 5));
 }
 
 TEST(RaiseToPlaneTop, OverTheColumnsThatClimbedAThinFrontsBorderColumnLeadsUp) {
@@ -101,38 +114,48 @@ TEST(RaiseToPlaneTop, OverTheColumnsThatClimbedAThinFrontsBorderColumnLeadsUp) {
   const cv::Point pi(15, 12);
   // The median of all three columns (5, 11, 11) stays near the region's top; over those that climbed
   // more than max_gap_px rows, PI goes up to the front's top.
-  EXPECT_EQ(raise_to_plane_top(f.labels, 1, pi, f.points, f.normal, f.offset, f.g, 0.5, 30, 1, 3), cv::Point(15, 11));
-  EXPECT_EQ(raise_to_plane_top(f.labels, 1, pi, f.points, f.normal, f.offset, f.g, 0.5, 30, 1, 3, true),
-            cv::Point(15, 5));
+  EXPECT_EQ(grow(f, pi, 0.5, 30, 1, 3), cv::Point(15, 11));
+  EXPECT_EQ(grow(f, pi, 0.5, 30, 1, 3, true), cv::Point(15, 5));
   // When no column climbed, all of them vote as before.
   for (int y = 0; y < 11; ++y) f.points.at<cv::Vec3f>(y, 15) = cv::Vec3f(NAN, NAN, NAN);
-  EXPECT_EQ(raise_to_plane_top(f.labels, 1, pi, f.points, f.normal, f.offset, f.g, 0.5, 30, 1, 3, true),
-            cv::Point(15, 11));
+  EXPECT_EQ(grow(f, pi, 0.5, 30, 1, 3, true), cv::Point(15, 11));
+}
+
+TEST(RaiseToPlaneTop, BridgesATallHoleWithItsOwnBudgetButNotRowsOffThePlane) {
+  FrontAboveItsRegion f;
+  // A hole of five rows (7..11) in a front: no depth, as on a page face StereoBM cannot match.
+  for (int y = 7; y < 12; ++y) f.points.at<cv::Vec3f>(y, 15) = cv::Vec3f(NAN, NAN, NAN);
+  const cv::Point pi(15, 12);
+  // Counted with the rows off the plane (max_hole_px -1), two rows do not bridge it ...
+  EXPECT_EQ(grow(f, pi, 0.5, 30, 2, 1, false, -1), pi);
+  // ... five rows of hole budget do, four do not.
+  EXPECT_EQ(grow(f, pi, 0.5, 30, 2, 1, false, 5), cv::Point(15, 5));
+  EXPECT_EQ(grow(f, pi, 0.5, 30, 2, 1, false, 4), pi);
+  // Rows off the plane still count against max_gap_px alone: one (row 6) past the hole is bridged with a
+  // gap budget of 2; with row 5 off too, rows 6, 5 and the wall's row 4 are three, and PI stays.
+  f.points.at<cv::Vec3f>(6, 15) *= 1.5f;
+  EXPECT_EQ(grow(f, pi, 0.5, 30, 2, 1, false, 30), cv::Point(15, 5));
+  f.points.at<cv::Vec3f>(5, 15) *= 1.5f;
+  EXPECT_EQ(grow(f, pi, 0.5, 30, 2, 1, false, 30), pi);
 }
 
 TEST(RaiseToPlaneTop, BridgesAStereoOutlier) {
   FrontAboveItsRegion f;
   f.points.at<cv::Vec3f>(9, 15) *= 1.5f;  // 3 m instead of 2 m: 8.3 px off the plane
-  EXPECT_EQ(raise_to_plane_top(f.labels, 1, {15, 12}, f.points, f.normal, f.offset, f.g, 0.5, 30, 1, 1),
-            cv::Point(15, 5));
-  EXPECT_EQ(raise_to_plane_top(f.labels, 1, {15, 12}, f.points, f.normal, f.offset, f.g, 0.5, 30, 0, 1),
-            cv::Point(15, 10));
+  EXPECT_EQ(grow(f, {15, 12}, 0.5, 30, 1, 1), cv::Point(15, 5));
+  EXPECT_EQ(grow(f, {15, 12}, 0.5, 30, 0, 1), cv::Point(15, 10));
 }
 
 TEST(RaiseToPlaneTop, StopsWhereTheDepthLeavesThePlane) {
   FrontAboveItsRegion f;
   // Rows 5..8 of column 15 at 2.1 m: 500 * 0.1 * (1/2 - 1/2.1) = 1.19 px off the plane.
   for (int y = 5; y <= 8; ++y) f.points.at<cv::Vec3f>(y, 15) *= float(2.1 / 2.0);
-  EXPECT_EQ(raise_to_plane_top(f.labels, 1, {15, 12}, f.points, f.normal, f.offset, f.g, 0.5, 30, 1, 1),
-            cv::Point(15, 9));
-  EXPECT_EQ(raise_to_plane_top(f.labels, 1, {15, 12}, f.points, f.normal, f.offset, f.g, 1.5, 30, 1, 1),
-            cv::Point(15, 5));
+  EXPECT_EQ(grow(f, {15, 12}, 0.5, 30, 1, 1), cv::Point(15, 9));
+  EXPECT_EQ(grow(f, {15, 12}, 1.5, 30, 1, 1), cv::Point(15, 5));
   // Never lower than PI, whatever the columns say.
-  EXPECT_EQ(raise_to_plane_top(f.labels, 1, {15, 3}, f.points, f.normal, f.offset, f.g, 0.5, 30, 1, 1),
-            cv::Point(15, 3));
-  EXPECT_THROW(
-      raise_to_plane_top(f.labels, 1, {15, 12}, cv::Mat(3, 3, CV_32FC3), f.normal, f.offset, f.g, 0.5, 30, 1, 1),
-      std::invalid_argument);
+  EXPECT_EQ(grow(f, {15, 3}, 0.5, 30, 1, 1), cv::Point(15, 3));
+  EXPECT_THROW(raise_to_plane_top(f.labels, 1, {15, 12}, cv::Mat(3, 3, CV_32FC3), f.normal, f.offset, f.g, {}),
+               std::invalid_argument);
 }
 
 SelectionParams selection_params() {
@@ -242,10 +265,10 @@ TEST(SelectBookFront, StereoBmDisparitySelectsABookFront) {
   DisparityParams dp;  // StereoBM as in config/services/bws_detector.yaml
   dp.block_size = 7;
   SelectionParams sp = selection_params();  // and its PI refinements
-  sp.top_growth_px = 80;
-  sp.top_growth_disparity_px = 0.75;
-  sp.top_growth_max_gap_px = 5;
-  sp.top_growth_columns = 3;
+  sp.top_growth.max_px = 80;
+  sp.top_growth.disparity_px = 0.75;
+  sp.top_growth.max_gap_px = 5;
+  sp.top_growth.columns = 3;
   sp.edge_fattening_px = 2.0;
   int right_count = 0;
   for (uint32_t seed : {1u, 2u, 3u}) {
@@ -287,6 +310,46 @@ TEST(SelectBookFront, StereoBmDisparitySelectsABookFront) {
     }
   }
   std::printf("StereoBM: right-most book in %d of 3 scenes\n", right_count);
+}
+
+// The segmentation loses the right-most front (its region is emptied, as when it breaks into pieces
+// that each fail the tests): the selection takes a front further left, and the front layer moves PI
+// back onto the right-most front. Fronts at the shelf's edge, as on the simulated cart; exact
+// disparity; truth used only to empty the region and to check.
+TEST(SelectBookFront, TheFrontLayerFindsTheRightMostFrontTheSegmentationLost) {
+  for (uint32_t seed : {1u, 2u, 3u, 4u}) {
+    const test::ShelfScene scene = test::make_shelf_scene(seed, true);
+    const test::RenderOutput ren = test::render_boxes(scene.boxes, scene.left, false);
+    const cv::Mat disp = test::exact_disparity(ren.depth, scene.left.fx, scene.baseline_m);
+    const StereoGeometry g{scene.left.fx, scene.left.fy, scene.left.cx, scene.left.cy, scene.baseline_m};
+    const cv::Mat pts = disparity_to_points(disp, g);
+    SegmentationResult seg = segment_god(disp, pts, god_params());
+    const ShelfVolume shelf{scene.shelf_box_in_base, scene.shelf_half_extent};
+    SelectionParams p = selection_params();
+    // With the segmentation as it is, the right book (so the scene is one the selection handles).
+    const BookFrontResult whole = select_book_front(seg, pts, g, scene.left.in_base, shelf, p);
+    ASSERT_TRUE(whole.found) << "seed " << seed << ": " << whole.failure_reason;
+    EXPECT_LT((whole.p1_base - scene.true_corner_base).norm(), 0.006) << "seed " << seed;
+    const int face = scene.rightmost_book * 6 + test::kFaceMinusX + 1;
+    seg.labels.setTo(cv::Scalar(0), ren.face_id == face);
+    const BookFrontResult without = select_book_front(seg, pts, g, scene.left.in_base, shelf, p);
+    ASSERT_TRUE(without.found) << "seed " << seed << ": " << without.failure_reason;
+    EXPECT_FALSE(without.pi_from_layer);
+    EXPECT_GT((without.p1_base - scene.true_corner_base).norm(), 0.010) << "seed " << seed << ": still the right book";
+    // Exact disparity: a tight layer (0.3 px, ~8 mm of depth at 1.4 m), so that the books' top faces
+    // near their fronts do not carry PI up.
+    p.layer_disparity_px = 0.3;
+    p.layer_min_rows = 15;
+    p.layer_min_columns = 2;
+    p.layer_min_shift_px = 3;
+    const BookFrontResult with = select_book_front(seg, pts, g, scene.left.in_base, shelf, p);
+    ASSERT_TRUE(with.found) << "seed " << seed << ": " << with.failure_reason;
+    EXPECT_TRUE(with.pi_from_layer) << "seed " << seed;
+    const Eigen::Vector3d err = with.p1_base - scene.true_corner_base;
+    std::printf("seed %u: layer P1 error base (mm) %.1f %.1f %.1f, without %.1f mm off\n", seed, 1e3 * err.x(),
+                1e3 * err.y(), 1e3 * err.z(), 1e3 * (without.p1_base - scene.true_corner_base).norm());
+    EXPECT_LT(err.norm(), 0.006) << "seed " << seed;
+  }
 }
 
 TEST(SelectBookFront, NothingOnTheShelfGivesAReason) {

@@ -121,6 +121,18 @@ TEST(BwsConfig, BadSelectionValuesNameTheKey) {
             std::string::npos);
   EXPECT_NE(err(replaced(ok, "  top_growth_climbed_only: true", "  # gone")).find("top_growth_climbed_only"),
             std::string::npos);
+  // Whatever value ships: -2 is below the -1 that means "counted with the rows off the plane".
+  EXPECT_NE(err(replaced(ok, "top_growth_max_hole_px:", "top_growth_max_hole_px: -2 #")).find("top_growth_max_hole_px"),
+            std::string::npos);
+  EXPECT_NE(err(replaced(ok, "  top_growth_max_hole_px:", "  # gone:")).find("top_growth_max_hole_px"),
+            std::string::npos);
+  EXPECT_NE(err(replaced(ok, "layer_disparity_px:", "layer_disparity_px: -0.5 #")).find("layer_disparity_px"),
+            std::string::npos);
+  EXPECT_NE(err(replaced(ok, "  layer_disparity_px:", "  # gone:")).find("layer_disparity_px"), std::string::npos);
+  EXPECT_NE(err(replaced(ok, "layer_min_rows:", "layer_min_rows: 0 #")).find("layer_min_rows"), std::string::npos);
+  EXPECT_NE(err(replaced(ok, "layer_min_columns:", "layer_min_columns: many #")).find("layer_min_columns"),
+            std::string::npos);
+  EXPECT_NE(err(replaced(ok, "  layer_min_shift_px:", "  # gone:")).find("layer_min_shift_px"), std::string::npos);
 }
 
 TEST(BwsConfig, BadPclSpaceValuesNameTheKey) {

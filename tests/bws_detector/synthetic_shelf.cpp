@@ -133,7 +133,7 @@ RenderOutput render_boxes(const std::vector<Box>& boxes, const PinholeCamera& ca
   return out;
 }
 
-ShelfScene make_shelf_scene(uint32_t seed) {
+ShelfScene make_shelf_scene(uint32_t seed, bool fronts_at_the_edge) {
   std::mt19937 rng(seed);
   auto uni = [&](double a, double b) { return std::uniform_real_distribution<double>(a, b)(rng); };
   ShelfScene s;
@@ -165,10 +165,11 @@ ShelfScene make_shelf_scene(uint32_t seed) {
     const double depth = portrait ? uni(0.15, 0.19) : uni(0.21, 0.26);
     const double t = uni(0.010, 0.035);
     if (y + t > half_w - 0.01) break;
-    add({D - depth, y, 0}, {D, y + t, h}, float(uni(0.35, 0.95)));
+    const double front = fronts_at_the_edge ? 0.01 : D - depth;
+    add({front, y, 0}, {front + depth, y + t, h}, float(uni(0.35, 0.95)));
     if (i == 0) {
       s.rightmost_book = int(s.boxes.size()) - 1;
-      s.true_corner_base = s.cart_in_base * Eigen::Vector3d(D - depth, y, h);
+      s.true_corner_base = s.cart_in_base * Eigen::Vector3d(front, y, h);
     }
     y += t + uni(0.0, 0.003);
     ++s.num_books;

@@ -84,9 +84,10 @@ constexpr int kFaceMinusX = 0;
 
 /// A seeded random scene: cart yaw +-4 deg, 8..14 books alternating portrait
 /// (height 0.21..0.26, depth 0.15..0.19 m) and landscape (height 0.15..0.19,
-/// depth 0.21..0.26 m), 1..3.5 cm thick, pushed against the rear board, gaps 0..3 mm.
-/// Stereo camera ~1.4 m from the shelf, 640x480, fovy 45 deg, baseline 0.12 m.
-ShelfScene make_shelf_scene(uint32_t seed);
+/// depth 0.21..0.26 m), 1..3.5 cm thick, pushed against the rear board, gaps 0..3 mm (with
+/// `fronts_at_the_edge`, the same books with their fronts 1 cm behind the shelf's front edge, as on the
+/// simulated cart). Stereo camera ~1.4 m from the shelf, 640x480, fovy 45 deg, baseline 0.12 m.
+ShelfScene make_shelf_scene(uint32_t seed, bool fronts_at_the_edge = false);
 
 /// Exact disparity f B / z of a depth image (NaN where depth is NaN).
 cv::Mat exact_disparity(const cv::Mat& depth, double fx, double baseline_m);
