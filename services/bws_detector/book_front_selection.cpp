@@ -537,10 +537,10 @@ BookFrontResult select_book_front(const SegmentationResult& seg, const cv::Mat& 
     double layer_offset = offset * rear_cam.dot(r.normal);  // replaced by the pixels' median below
     {
       std::vector<double> offs;
-      for (int y = 0; y < seg.labels.rows; ++y) {
+      for (int y = r.bbox.y; y < r.bbox.y + r.bbox.height; ++y) {
         const int* m = grow_mask.ptr<int>(y);
         const cv::Vec3f* q = points_camera.ptr<cv::Vec3f>(y);
-        for (int x = 0; x < seg.labels.cols; ++x)
+        for (int x = r.bbox.x; x < r.bbox.x + r.bbox.width; ++x)
           if (m[x] == best && point_ok(q[x])) offs.push_back(rear_cam.dot(Eigen::Vector3d(q[x][0], q[x][1], q[x][2])));
       }
       if (!offs.empty()) layer_offset = quantile(offs, 0.5);
@@ -549,13 +549,15 @@ BookFrontResult select_book_front(const SegmentationResult& seg, const cv::Mat& 
     thread_local cv::Mat layer;
     layer.create(seg.labels.size(), CV_32S);
     layer.setTo(cv::Scalar(0));
+    // Only the columns from PI's growth columns rightwards can matter.
+    const int x_begin = std::max(0, out.pi.x - p.top_growth.columns);
     std::vector<int> count(size_t(seg.labels.cols), 0);
     std::vector<int> first_row(size_t(seg.labels.cols), -1);
     std::vector<float> high(size_t(seg.labels.cols), -std::numeric_limits<float>::infinity());
     for (int y = 0; y < seg.labels.rows; ++y) {
       const cv::Vec3f* q = points_camera.ptr<cv::Vec3f>(y);
       int* o = layer.ptr<int>(y);
-      for (int x = 0; x < seg.labels.cols; ++x) {
+      for (int x = x_begin; x < seg.labels.cols; ++x) {
         if (!point_ok(q[x]) || q[x][2] <= 0.0f) continue;
         const double dn = rear_cam.dot(Eigen::Vector3d((x - g.cx) / g.fx, (y - g.cy) / g.fy, 1.0));
         if (std::fabs(dn) < 1e-9 || !(layer_offset / dn > 0.0)) continue;
@@ -573,7 +575,7 @@ BookFrontResult select_book_front(const SegmentationResult& seg, const cv::Mat& 
     // split_top_jump_px from column to column (a front's top is level; what lies on the plane beside
     // the right-most front, as block matching smears it, falls off column by column).
     int right = -1;
-    for (int x = seg.labels.cols - 1, run = 0; x >= 0 && right < 0; --x) {
+    for (int x = seg.labels.cols - 1, run = 0; x >= x_begin && right < 0; --x) {
       const size_t i = size_t(x);
       const bool filled = count[i] >= p.layer_min_rows && high[i] + shelf.half_extent.z() >= p.min_height_m;
       const bool level = run == 0 || std::abs(first_row[i] - first_row[i + 1]) <= p.split_top_jump_px;

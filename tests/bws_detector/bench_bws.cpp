@@ -28,6 +28,7 @@ struct Input {
   GodParams gp_stop33;  // the section shipped until stop 34: no smoothing, 16 bins, 5 x 5 voting (the baseline)
   PclPlaneParams pp, pp_metric;
   SelectionParams sp;
+  SelectionParams sp_stop34;  // the selection shipped until stop 35: no front layer, holes count as gaps (baseline)
   Input() {
     left = test::render_boxes(scene.boxes, scene.left, true).intensity;
     right = test::render_boxes(scene.boxes, scene.right, true).intensity;
@@ -50,6 +51,9 @@ struct Input {
     pp = PclPlaneParams::from_config(bookgrasp::Config::load_file(dir + "bws_detector_pcl.yaml").child("pcl"));
     sp = SelectionParams::from_config(bookgrasp::Config::load_file(dir + "bws_detector.yaml").child("selection"));
     gp = GodParams::from_config(bookgrasp::Config::load_file(dir + "bws_detector.yaml").child("god"));
+    sp_stop34 = sp;
+    sp_stop34.layer_disparity_px = 0.0;
+    sp_stop34.top_growth.max_hole_px = -1;
   }
 };
 Input& input() {
@@ -107,6 +111,15 @@ static void BM_BookFrontSelection(benchmark::State& s) {
     benchmark::DoNotOptimize(select_book_front(seg, in.points, in.g, in.scene.left.in_base, shelf, in.sp));
 }
 BENCHMARK(BM_BookFrontSelection)->Unit(benchmark::kMillisecond);
+
+static void BM_BookFrontSelection_Stop34Params(benchmark::State& s) {
+  auto& in = input();
+  const ShelfVolume shelf{in.scene.shelf_box_in_base, in.scene.shelf_half_extent};
+  const SegmentationResult seg = segment_god(in.disparity, in.points, in.gp);
+  for (auto _ : s)
+    benchmark::DoNotOptimize(select_book_front(seg, in.points, in.g, in.scene.left.in_base, shelf, in.sp_stop34));
+}
+BENCHMARK(BM_BookFrontSelection_Stop34Params)->Unit(benchmark::kMillisecond);
 
 static void BM_PclSegmentation(benchmark::State& s) {
   auto& in = input();
