@@ -59,8 +59,8 @@ struct TopGrowthParams {
   /// depth when max_hole_px is -1.
   int max_gap_px = 3;
   /// Rows without stereo depth bridged in a row, counted apart from the rows off the plane: a page face's
-  /// sparse texture leaves StereoBM holes 10-20 rows tall inside a front (docs/BWS.md "Holes in the
-  /// front"). -1 = counted with the rows off the plane, against max_gap_px.
+  /// sparse texture leaves StereoBM holes 6-22 rows tall inside a front (docs/BWS.md "Holes in the
+  /// front, the front layer"). -1 = counted with the rows off the plane, against max_gap_px.
   int max_hole_px = -1;
   /// PI's new row is the median of the grown tops of this many columns ending at PI's ...
   int columns = 3;
@@ -108,7 +108,7 @@ struct SelectionParams {
   /// disparity is within this (disparity px) of the selected front's plane are the fronts' layer; when
   /// its right-most well-filled columns lie right of PI, PI moves to the top of them. The right-most
   /// front often breaks into regions that each fail the tests while a front further left passes, but
-  /// the fronts stand in one plane (docs/BWS.md "The front layer").
+  /// the fronts stand in one plane (docs/BWS.md "Holes in the front, the front layer").
   double layer_disparity_px = 0.0;
   /// A layer column counts with at least this many layer pixels ...
   int layer_min_rows = 15;

@@ -103,22 +103,20 @@ static void BM_GodSegmentation_Stop33Params(benchmark::State& s) {
 BENCHMARK(BM_GodSegmentation)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_GodSegmentation_Stop33Params)->Unit(benchmark::kMillisecond);
 
-static void BM_BookFrontSelection(benchmark::State& s) {
+static void selection(benchmark::State& s, const SelectionParams& params) {
   auto& in = input();
   const ShelfVolume shelf{in.scene.shelf_box_in_base, in.scene.shelf_half_extent};
   const SegmentationResult seg = segment_god(in.disparity, in.points, in.gp);
   for (auto _ : s)
-    benchmark::DoNotOptimize(select_book_front(seg, in.points, in.g, in.scene.left.in_base, shelf, in.sp));
+    benchmark::DoNotOptimize(select_book_front(seg, in.points, in.g, in.scene.left.in_base, shelf, params));
+}
+static void BM_BookFrontSelection(benchmark::State& s) {
+  selection(s, input().sp);
+}
+static void BM_BookFrontSelection_Stop34Params(benchmark::State& s) {
+  selection(s, input().sp_stop34);
 }
 BENCHMARK(BM_BookFrontSelection)->Unit(benchmark::kMillisecond);
-
-static void BM_BookFrontSelection_Stop34Params(benchmark::State& s) {
-  auto& in = input();
-  const ShelfVolume shelf{in.scene.shelf_box_in_base, in.scene.shelf_half_extent};
-  const SegmentationResult seg = segment_god(in.disparity, in.points, in.gp);
-  for (auto _ : s)
-    benchmark::DoNotOptimize(select_book_front(seg, in.points, in.g, in.scene.left.in_base, shelf, in.sp_stop34));
-}
 BENCHMARK(BM_BookFrontSelection_Stop34Params)->Unit(benchmark::kMillisecond);
 
 static void BM_PclSegmentation(benchmark::State& s) {
