@@ -125,8 +125,11 @@ SceneResult evaluate_scene(const RenderedScene& scene, uint64_t seed, MarkerDete
     const int* w = scene.owner.ptr<int>(y);
     for (int x = std::max(0, pi.x - kCornerWindow); x <= std::min(o.segmentation.labels.cols - 1, pi.x + kCornerWindow);
          ++x) {
-      if (l[x] != out.selected_label) continue;
-      if (o.selection.split && (x < o.selection.band_x0 || x > o.selection.band_x1)) continue;
+      // PI moved onto the front layer lies outside the selected region: every pixel near it votes.
+      if (!o.selection.pi_from_layer) {
+        if (l[x] != out.selected_label) continue;
+        if (o.selection.split && (x < o.selection.band_x0 || x > o.selection.band_x1)) continue;
+      }
       ++votes[w[x]];
     }
   }
@@ -153,7 +156,8 @@ SceneResult evaluate_scene(const RenderedScene& scene, uint64_t seed, MarkerDete
   }
   if (nearest != right->id) {
     r.wrong_book = true;
-    r.failure = "wrong book: P1 is nearest to book " + std::to_string(nearest) + "'s corner; region at PI lies on " +
+    r.failure = "wrong book: P1 is nearest to book " + std::to_string(nearest) + "'s corner; " +
+                (o.selection.pi_from_layer ? "the pixels at PI (front layer) lie on " : "region at PI lies on ") +
                 (r.selected_owner >= 0 ? "book " + std::to_string(r.selected_owner)
                                        : "owner code " + std::to_string(r.selected_owner)) +
                 ", right-most is book " + std::to_string(right->id) + " (P1 error grasp mm " +

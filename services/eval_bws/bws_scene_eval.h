@@ -40,7 +40,8 @@ struct SceneResult {
   std::string failure;
   /// P1 error (estimate - truth) in the true grasp frame, metres (valid when found).
   Eigen::Vector3d error_grasp = Eigen::Vector3d::Zero();
-  /// Owner id (book id or negative code) covering most of the selected region.
+  /// Owner id (book id or negative code) covering most of the selected region near PI (most of the
+  /// pixels near PI when PI moved onto the front layer).
   int selected_owner = -100;
   /// Id of the right-most book (truth).
   int rightmost_id = -1;
