@@ -260,6 +260,78 @@ std::vector<std::pair<int, int>> column_bands(const cv::Mat& labels, int label, 
   return bands;
 }
 
+/// The right-most front on the fronts' layer (SelectionParams::layer_*), see rightmost_front_on_layer.
+struct FrontLayer {
+  /// Top of the layer's right-most front (its right-most column, topmost layer pixel with one below);
+  /// x = -1 if the layer has none.
+  cv::Point top{-1, -1};
+  /// The layer's pixels as `label`, 0 elsewhere (CV_32S; columns from x_begin only).
+  cv::Mat mask;
+  /// Offset of the layer's plane (normal . p = offset) through the right-most front's columns.
+  double offset = 0.0;
+};
+
+/// The fronts' layer: the pixels (columns x_begin.. only) whose disparity is within
+/// p.layer_disparity_px of the plane { normal . p = offset } (left camera frame) and whose point lies
+/// inside the upper-shelf volume (cam_in_box, half_extent). Its right-most front is the right-most run
+/// of p.layer_min_columns columns that each hold >= p.layer_min_rows layer pixels, reach p.min_height_m
+/// above the volume's floor (the shelf board's top near its front edge lies in the layer too, but low;
+/// a side board can hide a front's lower part), and whose topmost layer pixels differ by at most
+/// p.split_top_jump_px from column to column (a front's top is level; what block matching smears onto
+/// the plane beside the right-most front falls off column by column).
+FrontLayer rightmost_front_on_layer(const cv::Mat& points_camera, const StereoGeometry& g,
+                                    const Eigen::Vector3d& normal, double offset, const Eigen::Isometry3d& cam_in_box,
+                                    const Eigen::Vector3d& half_extent, int x_begin, int label,
+                                    const SelectionParams& p) {
+  const double fb = g.fx * g.baseline_m;
+  const int rows = points_camera.rows, cols = points_camera.cols;
+  thread_local cv::Mat mask;
+  mask.create(points_camera.size(), CV_32S);
+  mask.setTo(cv::Scalar(0));
+  std::vector<int> count(size_t(cols), 0), first_row(size_t(cols), -1);
+  std::vector<float> high(size_t(cols), -std::numeric_limits<float>::infinity());
+  for (int y = 0; y < rows; ++y) {
+    const cv::Vec3f* q = points_camera.ptr<cv::Vec3f>(y);
+    int* o = mask.ptr<int>(y);
+    for (int x = x_begin; x < cols; ++x) {
+      if (!(std::isfinite(q[x][0]) && std::isfinite(q[x][1]) && std::isfinite(q[x][2])) || q[x][2] <= 0.0f) continue;
+      const double dn = normal.dot(Eigen::Vector3d((x - g.cx) / g.fx, (y - g.cy) / g.fy, 1.0));
+      if (std::fabs(dn) < 1e-9 || !(offset / dn > 0.0)) continue;
+      if (std::fabs(fb / q[x][2] - fb * dn / offset) > p.layer_disparity_px) continue;
+      const Eigen::Vector3d qb = cam_in_box * Eigen::Vector3d(q[x][0], q[x][1], q[x][2]);
+      if (std::fabs(qb.x()) > half_extent.x() || std::fabs(qb.y()) > half_extent.y() ||
+          std::fabs(qb.z()) > half_extent.z())
+        continue;
+      o[x] = label;
+      if (count[size_t(x)]++ == 0) first_row[size_t(x)] = y;
+      high[size_t(x)] = std::max(high[size_t(x)], float(qb.z()));
+    }
+  }
+  FrontLayer out;
+  out.mask = mask;
+  int right = -1;
+  for (int x = cols - 1, run = 0; x >= x_begin && right < 0; --x) {
+    const size_t i = size_t(x);
+    const bool filled = count[i] >= p.layer_min_rows && high[i] + half_extent.z() >= p.min_height_m;
+    const bool level = run == 0 || std::abs(first_row[i] - first_row[i + 1]) <= p.split_top_jump_px;
+    run = filled ? (level ? run + 1 : 1) : 0;
+    if (run == p.layer_min_columns) right = x + p.layer_min_columns - 1;
+  }
+  if (right < 0) return out;
+  for (int y = 0; y + 1 < rows && out.top.x < 0; ++y)
+    if (mask.at<int>(y, right) == label && mask.at<int>(y + 1, right) == label) out.top = {right, y};
+  if (out.top.x < 0) return out;
+  std::vector<double> offs;
+  for (int y = 0; y < rows; ++y)
+    for (int x = std::max(0, right - p.layer_min_columns + 1); x <= right; ++x)
+      if (mask.at<int>(y, x) == label) {
+        const cv::Vec3f& q = points_camera.at<cv::Vec3f>(y, x);
+        offs.push_back(normal.dot(Eigen::Vector3d(q[0], q[1], q[2])));
+      }
+  out.offset = quantile(offs, 0.5);  // the run's columns hold >= layer_min_rows pixels each
+  return out;
+}
+
 }  // namespace
 
 BookFrontResult select_book_front(const SegmentationResult& seg, const cv::Mat& points_camera, const StereoGeometry& g,
@@ -530,77 +602,27 @@ BookFrontResult select_book_front(const SegmentationResult& seg, const cv::Mat& 
   cv::Mat grow_mask = out.split ? band_mask : inside_mask;
   Eigen::Vector3d normal = r.normal;  // of the plane PI's front lies in (left camera frame)
   if (p.layer_disparity_px > 0.0) {
-    // The fronts' layer: pixels inside the volume (as `best`) on the plane parallel to the rear board
-    // (the cart's, not the region's normal: a small region's normal can be 15 deg off, which tilts a
-    // plane across the shelf) through the selected front's pixels.
+    // The fronts' layer lies on the plane parallel to the rear board (the cart's normal, not the region's:
+    // a small region's normal can be 15 deg off, which tilts a plane across the shelf) through the
+    // selected front's pixels.
     const Eigen::Vector3d rear_cam = R.transpose() * rear_n;
-    double layer_offset = offset * rear_cam.dot(r.normal);  // replaced by the pixels' median below
-    {
-      std::vector<double> offs;
-      for (int y = r.bbox.y; y < r.bbox.y + r.bbox.height; ++y) {
-        const int* m = grow_mask.ptr<int>(y);
-        const cv::Vec3f* q = points_camera.ptr<cv::Vec3f>(y);
-        for (int x = r.bbox.x; x < r.bbox.x + r.bbox.width; ++x)
-          if (m[x] == best && point_ok(q[x])) offs.push_back(rear_cam.dot(Eigen::Vector3d(q[x][0], q[x][1], q[x][2])));
-      }
-      if (!offs.empty()) layer_offset = quantile(offs, 0.5);
-    }
-    const double fb = g.fx * g.baseline_m;
-    thread_local cv::Mat layer;
-    layer.create(seg.labels.size(), CV_32S);
-    layer.setTo(cv::Scalar(0));
-    // Only the columns from PI's growth columns rightwards can matter.
-    const int x_begin = std::max(0, out.pi.x - p.top_growth.columns);
-    std::vector<int> count(size_t(seg.labels.cols), 0);
-    std::vector<int> first_row(size_t(seg.labels.cols), -1);
-    std::vector<float> high(size_t(seg.labels.cols), -std::numeric_limits<float>::infinity());
-    for (int y = 0; y < seg.labels.rows; ++y) {
+    std::vector<double> offs;
+    for (int y = r.bbox.y; y < r.bbox.y + r.bbox.height; ++y) {
+      const int* m = grow_mask.ptr<int>(y);
       const cv::Vec3f* q = points_camera.ptr<cv::Vec3f>(y);
-      int* o = layer.ptr<int>(y);
-      for (int x = x_begin; x < seg.labels.cols; ++x) {
-        if (!point_ok(q[x]) || q[x][2] <= 0.0f) continue;
-        const double dn = rear_cam.dot(Eigen::Vector3d((x - g.cx) / g.fx, (y - g.cy) / g.fy, 1.0));
-        if (std::fabs(dn) < 1e-9 || !(layer_offset / dn > 0.0)) continue;
-        if (std::fabs(fb / q[x][2] - fb * dn / layer_offset) > p.layer_disparity_px) continue;
-        const Eigen::Vector3d qb = cam_in_box * Eigen::Vector3d(q[x][0], q[x][1], q[x][2]);
-        if (!in_volume(qb)) continue;
-        o[x] = best;
-        if (count[size_t(x)]++ == 0) first_row[size_t(x)] = y;
-        high[size_t(x)] = std::max(high[size_t(x)], float(qb.z()));
-      }
+      for (int x = r.bbox.x; x < r.bbox.x + r.bbox.width; ++x)
+        if (m[x] == best && point_ok(q[x])) offs.push_back(rear_cam.dot(Eigen::Vector3d(q[x][0], q[x][1], q[x][2])));
     }
-    // The right-most run of layer_min_columns well-filled columns that reach a book's height above the
-    // volume's floor (the shelf board's top near its front edge lies in the layer too, but low; a side
-    // board can hide a front's lower part), whose tops do not jump more than
-    // split_top_jump_px from column to column (a front's top is level; what lies on the plane beside
-    // the right-most front, as block matching smears it, falls off column by column).
-    int right = -1;
-    for (int x = seg.labels.cols - 1, run = 0; x >= x_begin && right < 0; --x) {
-      const size_t i = size_t(x);
-      const bool filled = count[i] >= p.layer_min_rows && high[i] + shelf.half_extent.z() >= p.min_height_m;
-      const bool level = run == 0 || std::abs(first_row[i] - first_row[i + 1]) <= p.split_top_jump_px;
-      run = filled ? (level ? run + 1 : 1) : 0;
-      if (run == p.layer_min_columns) right = x + p.layer_min_columns - 1;
-    }
-    if (right > out.pi.x + p.layer_min_shift_px) {
-      int top = -1;  // its topmost layer pixel with a layer pixel right below
-      for (int y = 0; y + 1 < seg.labels.rows && top < 0; ++y)
-        if (layer.at<int>(y, right) == best && layer.at<int>(y + 1, right) == best) top = y;
-      if (top >= 0) {
-        out.pi = {right, top};
+    if (!offs.empty()) {
+      const FrontLayer layer =
+          rightmost_front_on_layer(points_camera, g, rear_cam, quantile(offs, 0.5), cam_in_box, shelf.half_extent,
+                                   std::max(0, out.pi.x - p.top_growth.columns), best, p);
+      if (layer.top.x > out.pi.x + p.layer_min_shift_px) {
+        out.pi = layer.top;
         out.pi_from_layer = true;
-        grow_mask = layer;
-        // The plane of the front PI now lies on: the layer's normal, the offset of the layer's pixels in
-        // the right-most columns (fronts stand up to a few cm apart in depth).
+        grow_mask = layer.mask;
         normal = rear_cam;
-        std::vector<double> offs;
-        for (int y = 0; y < seg.labels.rows; ++y)
-          for (int x = std::max(0, right - p.layer_min_columns + 1); x <= right; ++x)
-            if (layer.at<int>(y, x) == best) {
-              const cv::Vec3f& q = points_camera.at<cv::Vec3f>(y, x);
-              offs.push_back(rear_cam.dot(Eigen::Vector3d(q[0], q[1], q[2])));
-            }
-        if (!offs.empty()) offset = quantile(offs, 0.5);
+        offset = layer.offset;
       }
     }
   }
