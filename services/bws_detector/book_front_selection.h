@@ -105,10 +105,12 @@ struct SelectionParams {
   /// leaves the top of a narrow front to a region mixed with the book's top face.
   TopGrowthParams top_growth;
   /// The front layer (0 = off): after PI is found, the pixels inside the upper-shelf volume whose
-  /// disparity is within this (disparity px) of the selected front's plane are the fronts' layer; when
-  /// its right-most well-filled columns lie right of PI, PI moves to the top of them. The right-most
-  /// front often breaks into regions that each fail the tests while a front further left passes, but
-  /// the fronts stand in one plane (docs/BWS.md "Holes in the front, the front layer").
+  /// disparity is within this (disparity px) of the plane parallel to the rear board through the
+  /// selected front's pixels are the fronts' layer. When its right-most front (the right-most run of
+  /// columns below, as tall as a book above the volume's floor, with a level top) lies right of PI, PI
+  /// moves to its top and P1 onto the layer's plane there. The right-most front often breaks into
+  /// regions that each fail the tests while a front further left passes, but the fronts stand in one
+  /// plane (docs/BWS.md "Holes in the front, the front layer").
   double layer_disparity_px = 0.0;
   /// A layer column counts with at least this many layer pixels ...
   int layer_min_rows = 15;
