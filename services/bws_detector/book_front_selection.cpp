@@ -38,6 +38,7 @@ SelectionParams SelectionParams::from_config(const Config& c) {
   p.layer_min_rows = c.get_int("layer_min_rows", 1, 10000);
   p.layer_min_columns = c.get_int("layer_min_columns", 1, 10000);
   p.layer_min_shift_px = c.get_int("layer_min_shift_px", 0, 10000);
+  p.layer_without_front_m = c.get_double("layer_without_front_m", 0.0, 10.0);
   p.edge_fattening_px = c.get_double("edge_fattening_px", 0.0, 100.0);
   p.pi_rule =
       c.get_choice("pi_rule", {"paper", "right_column_top"}) == "paper" ? PiRule::kPaper : PiRule::kRightColumnTop;
@@ -332,6 +333,71 @@ FrontLayer rightmost_front_on_layer(const cv::Mat& points_camera, const StereoGe
   return out;
 }
 
+/// Offset (normal . p = offset, left camera frame, normal = the rear board's) of the plane parallel to
+/// the rear board where the valid points inside the upper-shelf volume lie densest: the window of
+/// `window_m` along the box's x axis holding the most points (in steps of a third of it), and the
+/// median of the points inside it. NaN if no point lies inside the volume.
+double densest_layer_offset(const cv::Mat& points_camera, const Eigen::Isometry3d& cam_in_box,
+                            const Eigen::Vector3d& half_extent, double window_m) {
+  const double step = window_m / 3.0;
+  const int bins = int(std::ceil(2.0 * half_extent.x() / step)) + 1;
+  std::vector<int> count(size_t(bins), 0);
+  std::vector<double> xs;
+  for (int y = 0; y < points_camera.rows; ++y) {
+    const cv::Vec3f* q = points_camera.ptr<cv::Vec3f>(y);
+    for (int x = 0; x < points_camera.cols; ++x) {
+      if (!(std::isfinite(q[x][0]) && std::isfinite(q[x][1]) && std::isfinite(q[x][2])) || q[x][2] <= 0.0f) continue;
+      const Eigen::Vector3d b = cam_in_box * Eigen::Vector3d(q[x][0], q[x][1], q[x][2]);
+      if (std::fabs(b.x()) > half_extent.x() || std::fabs(b.y()) > half_extent.y() ||
+          std::fabs(b.z()) > half_extent.z())
+        continue;
+      xs.push_back(b.x());
+      ++count[size_t(std::min(bins - 1, int((b.x() + half_extent.x()) / step)))];
+    }
+  }
+  if (xs.empty()) return std::numeric_limits<double>::quiet_NaN();
+  int best = 0, best_count = -1;
+  for (int i = 0; i + 2 < bins || i == 0; ++i) {
+    int n = 0;
+    for (int k = i; k < std::min(bins, i + 3); ++k) n += count[size_t(k)];
+    if (n > best_count) {
+      best_count = n;
+      best = i;
+    }
+  }
+  const double lo = -half_extent.x() + best * step, hi = lo + 3.0 * step;
+  std::vector<double> in;
+  for (double v : xs)
+    if (v >= lo && v <= hi) in.push_back(v);
+  return quantile(in, 0.5) - cam_in_box.translation().x();
+}
+
+/// The end of the selection: PI (out.pi, on the pixels of `label` in `mask`) grows up the front's
+/// plane { normal . p = offset } (left camera frame), and P1 is where PI's ray meets that plane.
+BookFrontResult p1_on_plane(const cv::Mat& mask, int label, const Eigen::Vector3d& normal, double offset,
+                            const cv::Mat& points_camera, const StereoGeometry& g,
+                            const Eigen::Isometry3d& camera_in_base, const SelectionParams& p, BookFrontResult out) {
+  if (p.top_growth.max_px > 0)
+    out.pi = raise_to_plane_top(mask, label, out.pi, points_camera, normal, offset, g, p.top_growth);
+  // P1's ray: through PI moved edge_fattening_px left and down (StereoBM's border of a near surface
+  // in front of a farther one lies that far out; the right-most front's right and top edges are such).
+  const Eigen::Vector3d ray((out.pi.x - p.edge_fattening_px - g.cx) / g.fx,
+                            (out.pi.y + p.edge_fattening_px - g.cy) / g.fy, 1.0);
+  const double denom = normal.dot(ray);
+  if (std::fabs(denom) > 0.05 * ray.norm()) {
+    out.p1_camera = ray * (offset / denom);
+  } else {
+    const cv::Vec3f q = points_camera.at<cv::Vec3f>(out.pi);
+    if (!std::isfinite(q[2])) {
+      out.failure_reason = "PI has no 3D point and its ray is parallel to the region's plane";
+      return out;
+    }
+    out.p1_camera = Eigen::Vector3d(q[0], q[1], q[2]);
+  }
+  out.p1_base = camera_in_base * out.p1_camera;
+  out.found = true;
+  return out;
+}
 }  // namespace
 
 BookFrontResult select_book_front(const SegmentationResult& seg, const cv::Mat& points_camera, const StereoGeometry& g,
@@ -554,9 +620,25 @@ BookFrontResult select_book_front(const SegmentationResult& seg, const cv::Mat& 
   }
   for (auto& v : out.regions)
     if (v.candidate && v.label != best) v.reason = "candidate, not the right-most";
+  // The fronts' layer lies on the plane parallel to the rear board (the cart's normal, not the region's:
+  // a small region's normal can be 15 deg off, which tilts a plane across the shelf).
+  const Eigen::Vector3d rear_cam = R.transpose() * rear_n;
   if (best == 0) {
     out.failure_reason = seg.regions.empty() ? "no planar region" : "no region passed the book-front tests";
-    return out;
+    if (p.layer_disparity_px <= 0.0 || p.layer_without_front_m <= 0.0) return out;
+    const double offset = densest_layer_offset(points_camera, cam_in_box, shelf.half_extent, p.layer_without_front_m);
+    if (!std::isfinite(offset)) return out;
+    const int label = int(K) + 1;  // the layer's pixels in its mask: no region's label
+    const FrontLayer layer =
+        rightmost_front_on_layer(points_camera, g, rear_cam, offset, cam_in_box, shelf.half_extent, 0, label, p);
+    if (layer.top.x < 0) {
+      out.failure_reason += ", and the densest layer has no front";
+      return out;
+    }
+    out.failure_reason.clear();
+    out.pi = layer.top;
+    out.pi_from_layer = true;
+    return p1_on_plane(layer.mask, label, rear_cam, layer.offset, points_camera, g, camera_in_base, p, std::move(out));
   }
   const PlaneRegion& r = seg.regions[size_t(best - 1)];
   out.selected_label = best;
@@ -602,10 +684,7 @@ BookFrontResult select_book_front(const SegmentationResult& seg, const cv::Mat& 
   cv::Mat grow_mask = out.split ? band_mask : inside_mask;
   Eigen::Vector3d normal = r.normal;  // of the plane PI's front lies in (left camera frame)
   if (p.layer_disparity_px > 0.0) {
-    // The fronts' layer lies on the plane parallel to the rear board (the cart's normal, not the region's:
-    // a small region's normal can be 15 deg off, which tilts a plane across the shelf) through the
-    // selected front's pixels.
-    const Eigen::Vector3d rear_cam = R.transpose() * rear_n;
+    // The layer through the selected front's pixels.
     std::vector<double> offs;
     for (int y = r.bbox.y; y < r.bbox.y + r.bbox.height; ++y) {
       const int* m = grow_mask.ptr<int>(y);
@@ -626,26 +705,7 @@ BookFrontResult select_book_front(const SegmentationResult& seg, const cv::Mat& 
       }
     }
   }
-  if (p.top_growth.max_px > 0)
-    out.pi = raise_to_plane_top(grow_mask, best, out.pi, points_camera, normal, offset, g, p.top_growth);
-  // P1's ray: through PI moved edge_fattening_px left and down (StereoBM's border of a near surface
-  // in front of a farther one lies that far out; the right-most front's right and top edges are such).
-  const Eigen::Vector3d ray((out.pi.x - p.edge_fattening_px - g.cx) / g.fx,
-                            (out.pi.y + p.edge_fattening_px - g.cy) / g.fy, 1.0);
-  const double denom = normal.dot(ray);
-  if (std::fabs(denom) > 0.05 * ray.norm()) {
-    out.p1_camera = ray * (offset / denom);
-  } else {
-    const cv::Vec3f q = points_camera.at<cv::Vec3f>(out.pi);
-    if (!std::isfinite(q[2])) {
-      out.failure_reason = "PI has no 3D point and its ray is parallel to the region's plane";
-      return out;
-    }
-    out.p1_camera = Eigen::Vector3d(q[0], q[1], q[2]);
-  }
-  out.p1_base = camera_in_base * out.p1_camera;
-  out.found = true;
-  return out;
+  return p1_on_plane(grow_mask, best, normal, offset, points_camera, g, camera_in_base, p, std::move(out));
 }
 
 }  // namespace bookgrasp::bws

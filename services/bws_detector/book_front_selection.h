@@ -118,6 +118,12 @@ struct SelectionParams {
   int layer_min_columns = 2;
   /// ... and moves PI only when it lies more than this many columns right of PI.
   int layer_min_shift_px = 3;
+  /// When no region passes the tests (0 = off): the layer's plane (parallel to the rear board) is placed
+  /// where the points inside the upper-shelf volume lie densest along the rear board's normal, in a
+  /// window this deep (metres), and PI is the layer's right-most front. Fronts face the camera and stand
+  /// 0-2 cm apart in depth, while top faces spread over the shelf's depth; a far cart's fronts are only
+  /// a few pixels wide, too narrow for the segmentation (docs/BWS.md "A layer when no front passes").
+  double layer_without_front_m = 0.0;
   /// P1's viewing ray passes this many pixels left of and below PI: block matching extends a near
   /// surface into a farther background by up to half a block ((block_size - 1) / 2), and the
   /// right-most front's right and top edges border a farther background. 0 = the ray through PI.

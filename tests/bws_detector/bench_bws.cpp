@@ -116,8 +116,20 @@ static void BM_BookFrontSelection(benchmark::State& s) {
 static void BM_BookFrontSelection_Stop34Params(benchmark::State& s) {
   selection(s, input().sp_stop34);
 }
+/// The shipped selection on the same frame when no region passes (an empty segmentation): the
+/// layer placed where the volume's points are densest (`layer_without_front_m`), against
+/// BM_BookFrontSelection.
+static void BM_BookFrontSelection_NoRegionPasses(benchmark::State& s) {
+  auto& in = input();
+  const ShelfVolume shelf{in.scene.shelf_box_in_base, in.scene.shelf_half_extent};
+  SegmentationResult seg;
+  seg.labels = cv::Mat(in.disparity.size(), CV_32S, cv::Scalar(0));
+  for (auto _ : s)
+    benchmark::DoNotOptimize(select_book_front(seg, in.points, in.g, in.scene.left.in_base, shelf, in.sp));
+}
 BENCHMARK(BM_BookFrontSelection)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_BookFrontSelection_Stop34Params)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_BookFrontSelection_NoRegionPasses)->Unit(benchmark::kMillisecond);
 
 static void BM_PclSegmentation(benchmark::State& s) {
   auto& in = input();

@@ -352,6 +352,45 @@ TEST(SelectBookFront, TheFrontLayerFindsTheRightMostFrontTheSegmentationLost) {
   }
 }
 
+// The upper-shelf volume as the shipped config draws it (cart.upper_shelf_*_m): fronts up to 0.20 m
+// deep, the rear board outside. The synthetic scene's own box reaches 2 cm past the rear board.
+ShelfVolume shipped_volume(const test::ShelfScene& scene) {
+  const Eigen::Vector3d lo(-0.03, -0.45, 0.0), hi(0.20, 0.45, 0.30);
+  Eigen::Isometry3d box = scene.cart_in_base;
+  box.translate(0.5 * (lo + hi));
+  return {box, 0.5 * (hi - lo)};
+}
+
+// No region passes (the segmentation is emptied, as when a far cart's fronts are a few pixels wide):
+// the layer placed where the volume's points are densest along the rear board's normal finds the
+// right-most front. Exact disparity; truth used only to check.
+TEST(SelectBookFront, WithoutAnyFrontTheDensestLayerFindsTheRightMostFront) {
+  for (uint32_t seed : {1u, 2u, 3u, 4u}) {
+    const test::ShelfScene scene = test::make_shelf_scene(seed, true);
+    const test::RenderOutput ren = test::render_boxes(scene.boxes, scene.left, false);
+    const cv::Mat disp = test::exact_disparity(ren.depth, scene.left.fx, scene.baseline_m);
+    const StereoGeometry g{scene.left.fx, scene.left.fy, scene.left.cx, scene.left.cy, scene.baseline_m};
+    const cv::Mat pts = disparity_to_points(disp, g);
+    SegmentationResult seg;
+    seg.labels = cv::Mat(disp.size(), CV_32S, cv::Scalar(0));
+    const ShelfVolume shelf = shipped_volume(scene);
+    SelectionParams p = selection_params();
+    p.layer_disparity_px = 0.3;  // as in the test above
+    const BookFrontResult without = select_book_front(seg, pts, g, scene.left.in_base, shelf, p);
+    EXPECT_FALSE(without.found) << "seed " << seed;
+    EXPECT_EQ(without.failure_reason, "no planar region");
+    p.layer_without_front_m = 0.01;
+    const BookFrontResult with = select_book_front(seg, pts, g, scene.left.in_base, shelf, p);
+    ASSERT_TRUE(with.found) << "seed " << seed << ": " << with.failure_reason;
+    EXPECT_TRUE(with.pi_from_layer);
+    EXPECT_EQ(with.selected_label, 0);
+    const Eigen::Vector3d err = with.p1_base - scene.true_corner_base;
+    std::printf("seed %u: densest-layer P1 error base (mm) %.1f %.1f %.1f\n", seed, 1e3 * err.x(), 1e3 * err.y(),
+                1e3 * err.z());
+    EXPECT_LT(err.norm(), 0.006) << "seed " << seed;
+  }
+}
+
 TEST(SelectBookFront, NothingOnTheShelfGivesAReason) {
   test::ShelfScene scene = test::make_shelf_scene(1);
   scene.boxes.resize(size_t(scene.first_book));  // cart only
@@ -361,6 +400,16 @@ TEST(SelectBookFront, NothingOnTheShelfGivesAReason) {
   EXPECT_FALSE(r.found);
   EXPECT_EQ(r.failure_reason, "no region passed the book-front tests");
   for (const RegionVerdict& v : r.regions) EXPECT_FALSE(v.reason.empty());
+  // The layer without a front finds no book either: the boards in the volume are not a book's height.
+  SelectionParams p = selection_params();
+  p.layer_disparity_px = 0.75;
+  p.layer_without_front_m = 0.01;
+  const StereoGeometry g{scene.left.fx, scene.left.fy, scene.left.cx, scene.left.cy, scene.baseline_m};
+  const cv::Mat pts = disparity_to_points(disp, g);
+  const BookFrontResult l =
+      select_book_front(segment_god(disp, pts, god_params()), pts, g, scene.left.in_base, shipped_volume(scene), p);
+  EXPECT_FALSE(l.found) << "P1 at " << l.p1_base.transpose();
+  EXPECT_NE(l.failure_reason.find("the densest layer has no front"), std::string::npos) << l.failure_reason;
 }
 
 TEST(SelectBookFront, BadPointsAreRejected) {

@@ -133,6 +133,10 @@ TEST(BwsConfig, BadSelectionValuesNameTheKey) {
   EXPECT_NE(err(replaced(ok, "layer_min_columns:", "layer_min_columns: many #")).find("layer_min_columns"),
             std::string::npos);
   EXPECT_NE(err(replaced(ok, "  layer_min_shift_px:", "  # gone:")).find("layer_min_shift_px"), std::string::npos);
+  EXPECT_NE(err(replaced(ok, "layer_without_front_m:", "layer_without_front_m: -0.01 #")).find("layer_without_front_m"),
+            std::string::npos);
+  EXPECT_NE(err(replaced(ok, "  layer_without_front_m:", "  # gone:")).find("layer_without_front_m"),
+            std::string::npos);
 }
 
 TEST(BwsConfig, BadPclSpaceValuesNameTheKey) {
