@@ -149,6 +149,16 @@ cv::Point raise_to_plane_top(const cv::Mat& labels, int label, cv::Point pi, con
 }
 
 namespace {
+/// A stereo point with all three coordinates finite.
+bool finite_point(const cv::Vec3f& q) {
+  return std::isfinite(q[0]) && std::isfinite(q[1]) && std::isfinite(q[2]);
+}
+/// q (in the shelf box frame, float or double) inside the box of these half sizes.
+template <typename Vec>
+bool inside_box(const Vec& q, const Eigen::Vector3d& half_extent) {
+  return std::fabs(q.x()) <= half_extent.x() && std::fabs(q.y()) <= half_extent.y() &&
+         std::fabs(q.z()) <= half_extent.z();
+}
 size_t quantile_index(size_t n, double q) {
   return std::min(n - 1, size_t(std::floor(q * double(n - 1) + 0.5)));
 }
@@ -295,14 +305,12 @@ FrontLayer rightmost_front_on_layer(const cv::Mat& points_camera, const StereoGe
     const cv::Vec3f* q = points_camera.ptr<cv::Vec3f>(y);
     int* o = mask.ptr<int>(y);
     for (int x = x_begin; x < cols; ++x) {
-      if (!(std::isfinite(q[x][0]) && std::isfinite(q[x][1]) && std::isfinite(q[x][2])) || q[x][2] <= 0.0f) continue;
+      if (!finite_point(q[x]) || q[x][2] <= 0.0f) continue;
       const double dn = normal.dot(Eigen::Vector3d((x - g.cx) / g.fx, (y - g.cy) / g.fy, 1.0));
       if (std::fabs(dn) < 1e-9 || !(offset / dn > 0.0)) continue;
       if (std::fabs(fb / q[x][2] - fb * dn / offset) > p.layer_disparity_px) continue;
       const Eigen::Vector3d qb = cam_in_box * Eigen::Vector3d(q[x][0], q[x][1], q[x][2]);
-      if (std::fabs(qb.x()) > half_extent.x() || std::fabs(qb.y()) > half_extent.y() ||
-          std::fabs(qb.z()) > half_extent.z())
-        continue;
+      if (!inside_box(qb, half_extent)) continue;
       o[x] = label;
       if (count[size_t(x)]++ == 0) first_row[size_t(x)] = y;
       high[size_t(x)] = std::max(high[size_t(x)], float(qb.z()));
@@ -346,11 +354,9 @@ double densest_layer_offset(const cv::Mat& points_camera, const Eigen::Isometry3
   for (int y = 0; y < points_camera.rows; ++y) {
     const cv::Vec3f* q = points_camera.ptr<cv::Vec3f>(y);
     for (int x = 0; x < points_camera.cols; ++x) {
-      if (!(std::isfinite(q[x][0]) && std::isfinite(q[x][1]) && std::isfinite(q[x][2])) || q[x][2] <= 0.0f) continue;
+      if (!finite_point(q[x]) || q[x][2] <= 0.0f) continue;
       const Eigen::Vector3d b = cam_in_box * Eigen::Vector3d(q[x][0], q[x][1], q[x][2]);
-      if (std::fabs(b.x()) > half_extent.x() || std::fabs(b.y()) > half_extent.y() ||
-          std::fabs(b.z()) > half_extent.z())
-        continue;
+      if (!inside_box(b, half_extent)) continue;
       xs.push_back(b.x());
       ++count[size_t(std::min(bins - 1, int((b.x() + half_extent.x()) / step)))];
     }
@@ -389,7 +395,7 @@ BookFrontResult p1_on_plane(const cv::Mat& mask, int label, const Eigen::Vector3
   } else {
     const cv::Vec3f q = points_camera.at<cv::Vec3f>(out.pi);
     if (!std::isfinite(q[2])) {
-      out.failure_reason = "PI has no 3D point and its ray is parallel to the region's plane";
+      out.failure_reason = "PI has no 3D point and its ray is parallel to the front's plane";
       return out;
     }
     out.p1_camera = Eigen::Vector3d(q[0], q[1], q[2]);
@@ -410,14 +416,11 @@ BookFrontResult select_book_front(const SegmentationResult& seg, const cv::Mat& 
   const Eigen::Isometry3d cam_in_box = shelf.box_in_base.inverse() * camera_in_base;
   // All regions' points in one array, region by region (first[lab] .. first[lab + 1]), raster order within.
   std::vector<size_t> first(K + 2, 0);
-  const auto point_ok = [](const cv::Vec3f& q) {
-    return std::isfinite(q[0]) && std::isfinite(q[1]) && std::isfinite(q[2]);
-  };
   for (int y = 0; y < seg.labels.rows; ++y) {
     const int* l = seg.labels.ptr<int>(y);
     const cv::Vec3f* q = points_camera.ptr<cv::Vec3f>(y);
     for (int x = 0; x < seg.labels.cols; ++x)
-      if (l[x] > 0 && size_t(l[x]) <= K && point_ok(q[x])) ++first[size_t(l[x]) + 1];
+      if (l[x] > 0 && size_t(l[x]) <= K && finite_point(q[x])) ++first[size_t(l[x]) + 1];
   }
   for (size_t i = 1; i < first.size(); ++i) first[i] += first[i - 1];
   const Eigen::Matrix3d R = camera_in_base.linear();
@@ -425,10 +428,6 @@ BookFrontResult select_book_front(const SegmentationResult& seg, const cv::Mat& 
   const Eigen::Vector3d shelf_n = shelf.box_in_base.linear().col(2);
   const double cos_par = std::cos(p.parallel_tolerance_deg * M_PI / 180.0);
   const double sin_perp = std::sin(p.perpendicular_tolerance_deg * M_PI / 180.0);
-  const auto in_volume = [&](const auto& q) {  // q in the shelf box frame, float or double
-    return std::fabs(q.x()) <= shelf.half_extent.x() && std::fabs(q.y()) <= shelf.half_extent.y() &&
-           std::fabs(q.z()) <= shelf.half_extent.z();
-  };
   // Regions oriented like a book front are measured where each pixel's viewing ray meets the region's
   // fitted plane, not at the pixel's own noisy stereo point: a book front is 4-15 px wide, and the depth
   // noise of single pixels (several mm, along oblique rays partly across the shelf) made its extents and
@@ -458,8 +457,8 @@ BookFrontResult select_book_front(const SegmentationResult& seg, const cv::Mat& 
       const cv::Vec3f* q = points_camera.ptr<cv::Vec3f>(y);
       int* o = mask.ptr<int>(y);
       for (int x = r.bbox.x; x < r.bbox.x + r.bbox.width; ++x) {
-        if (l[x] != r.label || !point_ok(q[x])) continue;
-        if (in_volume(cam_in_box * measured_point(r, x, y, q[x]))) o[x] = r.label;
+        if (l[x] != r.label || !finite_point(q[x])) continue;
+        if (inside_box(cam_in_box * measured_point(r, x, y, q[x]), shelf.half_extent)) o[x] = r.label;
       }
     }
   };
@@ -474,7 +473,7 @@ BookFrontResult select_book_front(const SegmentationResult& seg, const cv::Mat& 
       const cv::Vec3f* q = points_camera.ptr<cv::Vec3f>(y);
       for (int x = 0; x < seg.labels.cols; ++x) {
         const int lab = l[x];
-        if (lab <= 0 || size_t(lab) > K || !point_ok(q[x])) continue;
+        if (lab <= 0 || size_t(lab) > K || !finite_point(q[x])) continue;
         box_pts[fill[size_t(lab)]++] =
             (cam_in_box * measured_point(seg.regions[size_t(lab - 1)], x, y, q[x])).cast<float>();
       }
@@ -512,7 +511,7 @@ BookFrontResult select_book_front(const SegmentationResult& seg, const cv::Mat& 
     const size_t num_pts = first[size_t(r.label) + 1] - first[size_t(r.label)];
     if (num_pts > 0) {
       size_t inside = 0;
-      for (size_t j = 0; j < num_pts; ++j) inside += in_volume(pts[j]);
+      for (size_t j = 0; j < num_pts; ++j) inside += inside_box(pts[j], shelf.half_extent);
       v.inside_fraction = double(inside) / double(num_pts);
       // A front-like region is measured by its part inside the volume (a shelf board's edge merged with
       // the fronts is not part of a book); other regions by all their points.
@@ -522,7 +521,7 @@ BookFrontResult select_book_front(const SegmentationResult& seg, const cv::Mat& 
       b2.clear();
       for (size_t j = 0; j < num_pts; ++j) {
         const Eigen::Vector3f& q = pts[j];
-        if (inside_only && !in_volume(q)) continue;
+        if (inside_only && !inside_box(q, shelf.half_extent)) continue;
         const Eigen::Vector3d qb = shelf.box_in_base * q.cast<double>();
         for (int i = 0; i < 3; ++i) c[i].push_back(qb(i));
         b1.push_back(q(1));
@@ -690,7 +689,8 @@ BookFrontResult select_book_front(const SegmentationResult& seg, const cv::Mat& 
       const int* m = grow_mask.ptr<int>(y);
       const cv::Vec3f* q = points_camera.ptr<cv::Vec3f>(y);
       for (int x = r.bbox.x; x < r.bbox.x + r.bbox.width; ++x)
-        if (m[x] == best && point_ok(q[x])) offs.push_back(rear_cam.dot(Eigen::Vector3d(q[x][0], q[x][1], q[x][2])));
+        if (m[x] == best && finite_point(q[x]))
+          offs.push_back(rear_cam.dot(Eigen::Vector3d(q[x][0], q[x][1], q[x][2])));
     }
     if (!offs.empty()) {
       const FrontLayer layer =
