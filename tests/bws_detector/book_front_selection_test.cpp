@@ -312,17 +312,33 @@ TEST(SelectBookFront, StereoBmDisparitySelectsABookFront) {
   std::printf("StereoBM: right-most book in %d of 3 scenes\n", right_count);
 }
 
+// The synthetic shelf with its fronts 1 cm behind the edge, rendered, with exact disparity and its points.
+struct ExactFrame {
+  test::ShelfScene scene;
+  test::RenderOutput ren;
+  cv::Mat disp, pts;
+  StereoGeometry g;
+};
+ExactFrame exact_frame(uint32_t seed) {
+  ExactFrame f;
+  f.scene = test::make_shelf_scene(seed, true);
+  f.ren = test::render_boxes(f.scene.boxes, f.scene.left, false);
+  f.disp = test::exact_disparity(f.ren.depth, f.scene.left.fx, f.scene.baseline_m);
+  f.g = {f.scene.left.fx, f.scene.left.fy, f.scene.left.cx, f.scene.left.cy, f.scene.baseline_m};
+  f.pts = disparity_to_points(f.disp, f.g);
+  return f;
+}
+
 // The segmentation loses the right-most front (its region is emptied, as when it breaks into pieces
 // that each fail the tests): the selection takes a front further left, and the front layer moves PI
 // back onto the right-most front. Fronts at the shelf's edge, as on the simulated cart; exact
 // disparity; truth used only to empty the region and to check.
 TEST(SelectBookFront, TheFrontLayerFindsTheRightMostFrontTheSegmentationLost) {
   for (uint32_t seed : {1u, 2u, 3u, 4u}) {
-    const test::ShelfScene scene = test::make_shelf_scene(seed, true);
-    const test::RenderOutput ren = test::render_boxes(scene.boxes, scene.left, false);
-    const cv::Mat disp = test::exact_disparity(ren.depth, scene.left.fx, scene.baseline_m);
-    const StereoGeometry g{scene.left.fx, scene.left.fy, scene.left.cx, scene.left.cy, scene.baseline_m};
-    const cv::Mat pts = disparity_to_points(disp, g);
+    const ExactFrame f = exact_frame(seed);
+    const test::ShelfScene& scene = f.scene;
+    const cv::Mat &disp = f.disp, &pts = f.pts;
+    const StereoGeometry& g = f.g;
     SegmentationResult seg = segment_god(disp, pts, god_params());
     const ShelfVolume shelf{scene.shelf_box_in_base, scene.shelf_half_extent};
     SelectionParams p = selection_params();
@@ -331,7 +347,7 @@ TEST(SelectBookFront, TheFrontLayerFindsTheRightMostFrontTheSegmentationLost) {
     ASSERT_TRUE(whole.found) << "seed " << seed << ": " << whole.failure_reason;
     EXPECT_LT((whole.p1_base - scene.true_corner_base).norm(), 0.006) << "seed " << seed;
     const int face = scene.rightmost_book * 6 + test::kFaceMinusX + 1;
-    seg.labels.setTo(cv::Scalar(0), ren.face_id == face);
+    seg.labels.setTo(cv::Scalar(0), f.ren.face_id == face);
     const BookFrontResult without = select_book_front(seg, pts, g, scene.left.in_base, shelf, p);
     ASSERT_TRUE(without.found) << "seed " << seed << ": " << without.failure_reason;
     EXPECT_FALSE(without.pi_from_layer);
@@ -366,11 +382,10 @@ ShelfVolume shipped_volume(const test::ShelfScene& scene) {
 // right-most front. Exact disparity; truth used only to check.
 TEST(SelectBookFront, WithoutAnyFrontTheDensestLayerFindsTheRightMostFront) {
   for (uint32_t seed : {1u, 2u, 3u, 4u}) {
-    const test::ShelfScene scene = test::make_shelf_scene(seed, true);
-    const test::RenderOutput ren = test::render_boxes(scene.boxes, scene.left, false);
-    const cv::Mat disp = test::exact_disparity(ren.depth, scene.left.fx, scene.baseline_m);
-    const StereoGeometry g{scene.left.fx, scene.left.fy, scene.left.cx, scene.left.cy, scene.baseline_m};
-    const cv::Mat pts = disparity_to_points(disp, g);
+    const ExactFrame f = exact_frame(seed);
+    const test::ShelfScene& scene = f.scene;
+    const cv::Mat &disp = f.disp, &pts = f.pts;
+    const StereoGeometry& g = f.g;
     SegmentationResult seg;
     seg.labels = cv::Mat(disp.size(), CV_32S, cv::Scalar(0));
     const ShelfVolume shelf = shipped_volume(scene);
