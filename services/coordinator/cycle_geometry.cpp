@@ -50,6 +50,9 @@ CycleGeometry CycleGeometry::from_config(const Config& c) {
   g.palm_half_width = c.get_double("grasp.palm_half_width_m", 0.0, 0.2);
   g.right_panel_clearance = c.get_double("grasp.right_panel_clearance_m", 0.0, 0.05);
   g.right_plate_min_clearance = c.get_double("grasp.right_plate_min_clearance_m", 0.0, 0.05);
+  g.palm_behind_tcp = c.get_double("grasp.palm_behind_tcp_m", 0.0, 0.2);
+  g.min_insertion_depth = c.get_double("grasp.min_insertion_depth_m", 0.0, g.insertion_depth);
+  g.side_panel_front_z = c.get_double("cart.side_panel_front_z_m", -0.2, 0.3);
   g.pre_grasp_distance = c.get_double("grasp.pre_grasp_distance_m", 0.01, 0.5);
   g.deep_front_z = c.get_double("grasp.deep_front_z_m", -0.2, 0.36);
   g.extract_lift = c.get_double("grasp.extract_lift_m", 0.0, 0.5);
@@ -197,6 +200,21 @@ PlateOpening plate_opening_clear_of_right_panel(const PlateOpening& o, double gp
   const double width = std::max(o.width, std::min(open_width, 2.0 * (g.right_plate_min_clearance - wanted)));
   const double lowest = std::min(o.offset_y, g.right_plate_min_clearance - 0.5 * width);
   return {width, std::max(wanted, lowest)};
+}
+
+PlateGrasp plate_grasp_clear_of_right_panel(const PlateOpening& o, const Eigen::Vector3d& gp, double open_width,
+                                            const CycleGeometry& g) {
+  if (palm_over_right_panel(o, gp.y(), g) <= 0) return {o, g.insertion_depth};
+  if (g.palm_behind_tcp > 0 && std::isfinite(gp.z())) {
+    // The palm's face at GP.z + insertion - palm_behind_tcp; the right plate's outer face o.width / 2 +
+    // plate_thickness right of the TCP.
+    const double palm_in_front = g.side_panel_front_z - g.right_panel_clearance + g.palm_behind_tcp - gp.z();
+    const double plate_over =
+        gp.y() + o.offset_y + 0.5 * o.width + g.plate_thickness + g.right_panel_clearance - g.shelf_right_y;
+    if (palm_in_front >= g.min_insertion_depth && plate_over <= 0)
+      return {o, std::min(g.insertion_depth, palm_in_front)};
+  }
+  return {plate_opening_clear_of_right_panel(o, gp.y(), open_width, g), g.insertion_depth};
 }
 
 bool holds_more_than_the_book(double plate_distance, const ForeEdges& edges, const CycleGeometry& g) {

@@ -61,6 +61,14 @@ struct CycleGeometry {
   double palm_half_width = 0.0;
   double right_panel_clearance = 0.005;      ///< see palm_half_width
   double right_plate_min_clearance = 0.003;  ///< the right plate's inner face at least this far right of GP
+  /// Not in the paper: the palm's front face this far behind the TCP along Z (lwa3_pg70.urdf: 30.9 mm). With it > 0,
+  /// a book near the right side panel is first grasped less deep instead of with the plates and palm moved left: the
+  /// TCP goes only so far beyond GP that the palm's face stays right_panel_clearance in front of the panels' front
+  /// edge (side_panel_front_z), but at least min_insertion_depth (plate_grasp_clear_of_right_panel). 0 = the move left
+  /// only.
+  double palm_behind_tcp = 0.0;
+  double min_insertion_depth = 0.01;  ///< see palm_behind_tcp
+  double side_panel_front_z = 0.0;    ///< grasp Z of the side panels' front edges
   double pre_grasp_distance = 0.10; ///< pre-grasp pose this far in front of GP along -Z
   /// Deepest GP (grasp Z) the pre-grasp and the extraction's end are measured from: a deeper front (books
   /// pushed back by an earlier grasp's left plate) gets the pre-grasp and the extraction's end a front at this
@@ -160,8 +168,6 @@ PlateOpening plate_opening(const ForeEdges& edges, double open_width, const Cycl
 /// inner face retry_left_clearance left of the measured fore-edge; the full opening when no width was measured.
 PlateOpening plate_opening_after_more_than_the_book(const ForeEdges& edges, double open_width, const CycleGeometry& g);
 
-/// True when plates closed to `plate_distance` hold more than the fore-edge `edges.front_width` (a measured width
-/// and more_than_the_book > 0 only).
 /// `o` moved left, plates and palm together, so that for a GP at grasp Y `gp_y` the palm's right side stays
 /// right_panel_clearance left of the right side panel (shelf_right_y). It moves no further than keeps the right
 /// plate's inner face right_plate_min_clearance right of GP (the book's right edge); an opening narrowed to the book
@@ -175,10 +181,27 @@ PlateOpening plate_opening_clear_of_right_panel(const PlateOpening& o, double gp
 /// with the opening `o` (> 0: it meets the panel or comes too near; <= 0: clear). 0 with palm_half_width 0.
 double palm_over_right_panel(const PlateOpening& o, double gp_y, const CycleGeometry& g);
 
+/// Where the plates go into the book: their opening across the books and how deep.
+struct PlateGrasp {
+  PlateOpening opening;          ///< plate gap and TCP offset along Y
+  double insertion_depth = 0.0;  ///< TCP this far beyond GP along Z (replaces CycleGeometry::insertion_depth)
+};
+
+/// The grasp of the opening `o` at GP `gp` (grasp frame) clear of the right side panel. Where the palm would come
+/// nearer the panel than right_panel_clearance (palm_over_right_panel), and palm_behind_tcp > 0: the plates go in
+/// only so deep that the palm's face stays right_panel_clearance in front of the panels' front edge
+/// (side_panel_front_z), when that is at least min_insertion_depth and the right plate itself (plate_thickness) stays
+/// right_panel_clearance left of the panel. Otherwise the full insertion_depth with `o` moved left
+/// (plate_opening_clear_of_right_panel). Far from the panel: `o` and insertion_depth.
+PlateGrasp plate_grasp_clear_of_right_panel(const PlateOpening& o, const Eigen::Vector3d& gp, double open_width,
+                                            const CycleGeometry& g);
+
 /// The plate opening to release a book `book_width` wide on the lower shelf: the book plus
 /// `lower_release_opening`, or 0 (the gripper's full opening) when that is 0.
 double lower_release_width(double book_width, const CycleGeometry& g);
 
+/// True when plates closed to `plate_distance` hold more than the fore-edge `edges.front_width` (a measured width
+/// and more_than_the_book > 0 only).
 bool holds_more_than_the_book(double plate_distance, const ForeEdges& edges, const CycleGeometry& g);
 /// Book height above its support at the TCP: GP.x (top above the upper shelf) plus the X offset.
 double tcp_height_on_book(const Eigen::Vector3d& gp_grasp, const CycleGeometry& g);

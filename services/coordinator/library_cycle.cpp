@@ -385,14 +385,19 @@ PlateOpening LibraryCycle::book_opening() const {
              : plate_opening(fore_edges_, s_.gripper_open_width, s_.geometry);
 }
 
+PlateGrasp LibraryCycle::plate_grasp() const {
+  return plate_grasp_clear_of_right_panel(book_opening(), progress_.gp_grasp, s_.gripper_open_width, s_.geometry);
+}
+
 PlateOpening LibraryCycle::grasp_opening() const {
-  return plate_opening_clear_of_right_panel(book_opening(), progress_.gp_grasp.y(), s_.gripper_open_width,
-                                            s_.geometry);
+  return plate_grasp().opening;
 }
 
 CycleGeometry LibraryCycle::grasp_geometry() const {
+  const PlateGrasp p = plate_grasp();
   CycleGeometry g = s_.geometry;
-  g.grasp_offset_y = grasp_opening().offset_y;
+  g.grasp_offset_y = p.opening.offset_y;
+  g.insertion_depth = p.insertion_depth;
   return g;
 }
 
@@ -715,7 +720,7 @@ void LibraryCycle::enter(CycleState s) {
       out_.back().speed = s_.gripper_speed;
       const Eigen::Isometry3d here = arm_->end_effector;
       // Back to where the pre-grasp was (deeper for a front pushed back).
-      const double back = pre_grasp_back_off(progress_.gp_grasp.z(), g) + g.insertion_depth;
+      const double back = pre_grasp_back_off(progress_.gp_grasp.z(), g) + grasp_geometry().insertion_depth;
       start_linear({move_along_own_axes(here, Eigen::Vector3d(0, 0, -back))});
       break;
     }
@@ -791,7 +796,11 @@ void LibraryCycle::enter(CycleState s) {
       const PlateOpening opening = grasp_opening();
       const double shift = book_opening().offset_y - opening.offset_y;
       const double over = palm_over_right_panel(opening, progress_.gp_grasp.y(), s_.geometry);
-      if (over > 1e-4)  // not a rounding error's 1e-17 of a move that just clears
+      const double shallower = g.insertion_depth - gw.insertion_depth;
+      if (shallower > 1e-4)
+        message_ += "; the plates go " + mm(gw.insertion_depth) + " beyond GP, " + mm(shallower) +
+                    " less deep than grasp.insertion_depth_m: the palm stays in front of the right side panel";
+      else if (over > 1e-4)  // not a rounding error's 1e-17 of a move that just clears
         message_ += "; the palm comes " + mm(over) + " nearer the right side panel than grasp.right_panel_clearance_m" +
                     " allows, with the plates " + mm(shift) + " further left: INSERT may meet the panel";
       else if (shift > 0)
@@ -799,7 +808,7 @@ void LibraryCycle::enter(CycleState s) {
       const Eigen::Isometry3d grasp = grasp_pose(gp_base_, gw);
       std::vector<Eigen::Isometry3d> then{grasp};
       for (const Eigen::Isometry3d& p : extract_moves(grasp, cart_frame(), tcp_height(),
-                                                      moves_front_z(progress_.gp_grasp.z(), g) + g.insertion_depth, g))
+                                                      moves_front_z(progress_.gp_grasp.z(), g) + gw.insertion_depth, g))
         then.push_back(p);
       start_planned_pose(pre_grasp_pose(gp_base_, progress_.gp_grasp.z(), gw), false, std::move(then));
       break;
@@ -824,7 +833,7 @@ void LibraryCycle::enter(CycleState s) {
       break;
     case CycleState::kExtract: {
       start_linear(extract_moves(arm_->end_effector, cart_frame(), tcp_height(),
-                                 moves_front_z(progress_.gp_grasp.z(), g) + g.insertion_depth, g));
+                                 moves_front_z(progress_.gp_grasp.z(), g) + grasp_geometry().insertion_depth, g));
       break;
     }
     case CycleState::kMoveToHolder: {

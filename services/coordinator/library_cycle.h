@@ -324,9 +324,12 @@ class LibraryCycle {
   void start_gripper(bool grasp, double open_width = 0);
   /// This attempt's plate opening for the book (plate_opening() with the corner servo's fore-edges).
   PlateOpening book_opening() const;
-  /// book_opening() moved clear of the right side panel (plate_opening_clear_of_right_panel()).
+  /// This attempt's grasp clear of the right side panel: book_opening() at a shallower insertion or moved left
+  /// (plate_grasp_clear_of_right_panel()).
+  PlateGrasp plate_grasp() const;
+  /// plate_grasp()'s opening.
   PlateOpening grasp_opening() const;
-  /// The geometry with this attempt's grasp_opening() offset.
+  /// The geometry with this attempt's plate_grasp() offset and insertion depth.
   CycleGeometry grasp_geometry() const;
   void issue_plan();
   void drive_motion(const ArmEvent& e);

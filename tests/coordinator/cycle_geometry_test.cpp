@@ -5,6 +5,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <string>
+#include <utility>
 
 namespace bookgrasp {
 namespace {
@@ -125,6 +127,57 @@ TEST(CycleGeometry, ABookNearTheRightSidePanelMovesPlatesAndPalmLeft) {
     if (std::isfinite(gp_y)) off.palm_half_width = 0.0;
     EXPECT_EQ(plate_opening_clear_of_right_panel(full, gp_y, 0.06, off).offset_y, -0.015) << gp_y;
     EXPECT_EQ(palm_over_right_panel(full, gp_y, off), 0.0) << gp_y;
+  }
+}
+
+TEST(CycleGeometry, ABookNearTheRightSidePanelIsGraspedLessDeepWithThePalmInFrontOfIt) {
+  // coordinator.yaml's values: the palm's face 30.9 mm behind the TCP, the panels' front edge at grasp Z 0.
+  CycleGeometry g;
+  g.shelf_right_y = 0.40;
+  g.grasp_offset_y = -0.015;
+  g.insertion_depth = 0.03;
+  g.palm_half_width = 0.057;
+  g.right_panel_clearance = 0.005;
+  g.right_plate_min_clearance = 0.003;
+  g.plate_thickness = 0.010;
+  g.palm_behind_tcp = 0.0309;
+  g.min_insertion_depth = 0.005;
+  g.side_panel_front_z = 0.0;
+  const PlateOpening full{0.06, -0.015};
+  const auto expect_unchanged = [&](const PlateGrasp& p, const std::string& what) {
+    EXPECT_EQ(p.opening.width, 0.06) << what;
+    EXPECT_EQ(p.opening.offset_y, -0.015) << what;
+    EXPECT_EQ(p.insertion_depth, 0.03) << what;
+  };
+  // Far from the panel: the opening and the full insertion.
+  expect_unchanged(plate_grasp_clear_of_right_panel(full, Eigen::Vector3d(0.2, 0.30, 0.01), 0.06, g), "far");
+  // Far_cart seed 5076's GPs (a 10 mm book, 40 mm from the panel). The fore-edge 3.2 mm deep: the TCP 22.7 mm beyond
+  // it puts the palm's face 5 mm in front of the panel; the plates stay where they were.
+  const PlateGrasp shallow = plate_grasp_clear_of_right_panel(full, Eigen::Vector3d(0.166, 0.3605, 0.0032), 0.06, g);
+  EXPECT_NEAR(shallow.insertion_depth, 0.0227, 1e-12);
+  EXPECT_NEAR(0.0032 + shallow.insertion_depth - g.palm_behind_tcp, -0.005, 1e-12);
+  EXPECT_EQ(shallow.opening.offset_y, -0.015);
+  EXPECT_EQ(shallow.opening.width, 0.06);
+  // 18.4 mm deep: 7.5 mm, still over min_insertion_depth_m.
+  EXPECT_NEAR(plate_grasp_clear_of_right_panel(full, Eigen::Vector3d(0.166, 0.363, 0.0184), 0.06, g).insertion_depth,
+              0.0075, 1e-12);
+  // A front standing out of the shelf: the palm is in front of the panel at the full insertion.
+  expect_unchanged(plate_grasp_clear_of_right_panel(full, Eigen::Vector3d(0.2, 0.3605, -0.02), 0.06, g), "out");
+  // Too deep for min_insertion_depth (24 mm: 1.9 mm), the right plate itself too near the panel (GP at 375 mm: its
+  // outer face at 395 mm + 10 mm), the palm's depth unknown (0) or no GP depth: the plates and palm move left, as
+  // plate_opening_clear_of_right_panel moves them, at the full insertion.
+  CycleGeometry no_depth = g;
+  no_depth.palm_behind_tcp = 0.0;
+  for (const auto& [gp, geometry] :
+       {std::pair{Eigen::Vector3d(0.2, 0.3605, 0.024), g}, std::pair{Eigen::Vector3d(0.2, 0.375, 0.003), g},
+        std::pair{Eigen::Vector3d(0.2, 0.3605, 0.003), no_depth},
+        std::pair{Eigen::Vector3d(0.2, 0.3605, double(NAN)), g}}) {
+    const PlateGrasp p = plate_grasp_clear_of_right_panel(full, gp, 0.06, geometry);
+    const PlateOpening moved = plate_opening_clear_of_right_panel(full, gp.y(), 0.06, geometry);
+    EXPECT_EQ(p.insertion_depth, 0.03) << gp.transpose();
+    EXPECT_EQ(p.opening.offset_y, moved.offset_y) << gp.transpose();
+    EXPECT_EQ(p.opening.width, moved.width) << gp.transpose();
+    EXPECT_LT(p.opening.offset_y, -0.015) << gp.transpose();
   }
 }
 

@@ -535,30 +535,51 @@ TEST(LibraryCycle, PlatesClosedOnMoreThanTheBookTryAgainOpenedToTheBookOnly) {
 }
 
 TEST(LibraryCycle, ABookNearTheRightSidePanelIsGraspedWithThePalmClearOfIt) {
-  // coordinator.yaml: the panel at cart.shelf_right_y_m 0.40, palm_half_width_m 57 mm, right_panel_clearance_m 5 mm,
-  // offset_y_m -15 mm. Book 0's right cover at 0.36: the TCP goes to 0.40 - 0.005 - 0.057 = 0.338, not 0.345.
-  const CycleSettings cs = settings();
-  ASSERT_NEAR(cs.geometry.shelf_right_y, 0.40, 1e-12);
-  ASSERT_NEAR(cs.geometry.palm_half_width, 0.057, 1e-12);
-  ASSERT_NEAR(cs.geometry.right_panel_clearance, 0.005, 1e-12);
-  ASSERT_NEAR(cs.geometry.grasp_offset_y, -0.015, 1e-12);
-  std::vector<FakeBook> books = three_books();
-  books[0].right_y = 0.36;
-  FakeLibrary w(books);
-  LibraryCycle cycle(cs, std::nullopt);
-  w.run(cycle, [&] { return done_or_aborted(cycle); });
-  ASSERT_EQ(cycle.state(), CycleState::kDone) << cycle.status().message;
-  std::vector<double> insert_end_y;  // the TCP's grasp Y at the end of each INSERT
-  for (size_t i = 0; i + 1 < w.tcp_path.size(); ++i)
-    if (w.tcp_path[i].first == "INSERT" && w.tcp_path[i + 1].first != "INSERT")
-      insert_end_y.push_back((hand_grasp_frame().inverse() * w.tcp_path[i].second).y());
-  ASSERT_EQ(insert_end_y.size(), 3u);
-  EXPECT_NEAR(insert_end_y[0], 0.338, 1e-3);
-  EXPECT_NEAR(insert_end_y[1], books[1].right_y - 0.015, 1e-3);  // far from the panel: offset_y_m as configured
-  const bool said = std::any_of(w.messages.begin(), w.messages.end(), [](const std::string& m) {
-    return m.find("plates and palm 7.0 mm further left, clear of the right side panel") != std::string::npos;
-  });
-  EXPECT_TRUE(said);
+  // coordinator.yaml: the panel at cart.shelf_right_y_m 0.40, its front edge at grasp Z 0, palm_half_width_m 57 mm,
+  // right_panel_clearance_m 5 mm, offset_y_m -15 mm, insertion_depth_m 30 mm, the palm's face 30.9 mm behind the TCP.
+  // Book 0's right cover at 0.36, its fore-edge at Z 0.01 (the fake arbiter's GP): the plates go in 15.9 mm, so that
+  // the palm's face stays 5 mm in front of the panel, at Y 0.345. Without the palm's depth (palm_behind_tcp_m 0)
+  // they go the full 30 mm, moved left: the TCP at 0.40 - 0.005 - 0.057 = 0.338.
+  const CycleSettings shipped = settings();
+  ASSERT_NEAR(shipped.geometry.shelf_right_y, 0.40, 1e-12);
+  ASSERT_NEAR(shipped.geometry.side_panel_front_z, 0.0, 1e-12);
+  ASSERT_NEAR(shipped.geometry.palm_half_width, 0.057, 1e-12);
+  ASSERT_NEAR(shipped.geometry.right_panel_clearance, 0.005, 1e-12);
+  ASSERT_NEAR(shipped.geometry.grasp_offset_y, -0.015, 1e-12);
+  ASSERT_NEAR(shipped.geometry.insertion_depth, 0.03, 1e-12);
+  ASSERT_NEAR(shipped.geometry.palm_behind_tcp, 0.0309, 1e-12);
+  CycleSettings moved_left = shipped;
+  moved_left.geometry.palm_behind_tcp = 0.0;
+  struct Case {
+    CycleSettings settings;
+    double tcp_y, tcp_z;
+    std::string said;
+  };
+  for (const Case& c :
+       {Case{shipped, 0.345, 0.0259,
+             "the plates go 15.9 mm beyond GP, 14.1 mm less deep than grasp.insertion_depth_m: the palm "
+             "stays in front of the right side panel"},
+        Case{moved_left, 0.338, 0.04, "plates and palm 7.0 mm further left, clear of the right side panel"}}) {
+    std::vector<FakeBook> books = three_books();
+    books[0].right_y = 0.36;
+    FakeLibrary w(books);
+    LibraryCycle cycle(c.settings, std::nullopt);
+    w.run(cycle, [&] { return done_or_aborted(cycle); });
+    ASSERT_EQ(cycle.state(), CycleState::kDone) << cycle.status().message;
+    std::vector<Eigen::Vector3d> insert_end;  // the TCP in the grasp frame at the end of each INSERT
+    for (size_t i = 0; i + 1 < w.tcp_path.size(); ++i)
+      if (w.tcp_path[i].first == "INSERT" && w.tcp_path[i + 1].first != "INSERT")
+        insert_end.push_back(hand_grasp_frame().inverse() * w.tcp_path[i].second);
+    ASSERT_EQ(insert_end.size(), 3u) << c.said;
+    EXPECT_NEAR(insert_end[0].y(), c.tcp_y, 1e-3) << c.said;
+    EXPECT_NEAR(insert_end[0].z(), c.tcp_z, 1e-3) << c.said;
+    // Far from the panel: offset_y_m and insertion_depth_m as configured.
+    EXPECT_NEAR(insert_end[1].y(), books[1].right_y - 0.015, 1e-3) << c.said;
+    EXPECT_NEAR(insert_end[1].z(), 0.04, 1e-3) << c.said;
+    const bool said = std::any_of(w.messages.begin(), w.messages.end(),
+                                  [&](const std::string& m) { return m.find(c.said) != std::string::npos; });
+    EXPECT_TRUE(said) << c.said;
+  }
 }
 
 TEST(LibraryCycle, TheShippedPlateCheckSeparatesTheMeasuredGraspsFromTheDoubleLifts) {
@@ -611,6 +632,10 @@ TEST(LibraryCycle, BadDepthKeysNameTheKey) {
         {"grasp.retry_left_clearance_m", "retry_left_clearance_m: 0.005", "retry_left_clearance_m: 0.0"},
         {"grasp.more_than_the_book_m", "more_than_the_book_m: 0.0025", "more_than_the_book_m: 0.2"},
         {"grasp.width_left_clearance_m", "width_left_clearance_m: 0.005", "width_left_clearance_m: 0.2"},
+        {"grasp.palm_behind_tcp_m", "palm_behind_tcp_m: 0.0309", "palm_behind_tcp_m: -0.03"},
+        // Deeper than insertion_depth_m (0.03): the shallower grasp near the panel would go deeper.
+        {"grasp.min_insertion_depth_m", "min_insertion_depth_m: 0.005", "min_insertion_depth_m: 0.05"},
+        {"cart.side_panel_front_z_m", "side_panel_front_z_m: 0.0 ", "side_panel_front_z_m: nan "},
         {"holder.regrasp_min_height_m", "regrasp_min_height_m: 0.15", "regrasp_min_height_m: -0.1"},
         {"lower_shelf.release_opening_m", "release_opening_m: 0.006 ", "release_opening_m: 0.1 "},
         {"lower_shelf.retry_shift_m", "retry_shift_m: 0.03 ", "retry_shift_m: -0.03 "},
