@@ -273,6 +273,10 @@ std::vector<std::pair<std::string, OrientedBox>> LibraryCycle::placed_book_obsta
 double LibraryCycle::held_box_height() const {
   return std::max(0.0, progress_.gp_grasp.x());
 }
+double LibraryCycle::held_box_depth() const {
+  if (progress_.place != BookPlace::kInGripperFromShelf) return s_.held_book_depth_m;
+  return s_.held_book_depth_m + std::max(0.0, s_.geometry.insertion_depth - inserted_depth());
+}
 double LibraryCycle::tcp_height() const {
   return tcp_height_on_book(progress_.gp_grasp, s_.geometry);
 }
@@ -359,7 +363,7 @@ void LibraryCycle::issue_plan() {
   motion_.plan_start = arm_->joints;
   r.holding_book = motion_.holding;
   r.then_poses = motion_.then;
-  if (motion_.holding) r.book_size = Eigen::Vector3d(progress_.book_width, held_box_height(), s_.held_book_depth_m);
+  if (motion_.holding) r.book_size = Eigen::Vector3d(progress_.book_width, held_box_height(), held_box_depth());
   r.obstacles = placed_book_obstacles();
   out_.push_back(r);
 }
@@ -399,6 +403,11 @@ CycleGeometry LibraryCycle::grasp_geometry() const {
   g.grasp_offset_y = p.opening.offset_y;
   g.insertion_depth = p.insertion_depth;
   return g;
+}
+
+double LibraryCycle::inserted_depth() const {
+  return std::isfinite(progress_.grasp_insertion_depth) ? progress_.grasp_insertion_depth
+                                                        : grasp_geometry().insertion_depth;
 }
 
 void LibraryCycle::start_gripper(bool grasp, double open_width) {
@@ -668,6 +677,7 @@ void LibraryCycle::book_done(bool handed_over) {
   lower_slot_shift_ = 0.0;
   progress_.place = BookPlace::kUpperShelf;
   progress_.have_book_data = false;
+  progress_.grasp_insertion_depth = std::numeric_limits<double>::quiet_NaN();
   progress_.hand_over_reason.clear();
   const std::string where = handed_over ? " taken off the holder by the librarian" : " on the lower shelf";
   // Rule (a): the room left of this book, up to the shelf's left end, cannot hold an admissible book.
@@ -720,7 +730,7 @@ void LibraryCycle::enter(CycleState s) {
       out_.back().speed = s_.gripper_speed;
       const Eigen::Isometry3d here = arm_->end_effector;
       // Back to where the pre-grasp was (deeper for a front pushed back).
-      const double back = pre_grasp_back_off(progress_.gp_grasp.z(), g) + grasp_geometry().insertion_depth;
+      const double back = pre_grasp_back_off(progress_.gp_grasp.z(), g) + inserted_depth();
       start_linear({move_along_own_axes(here, Eigen::Vector3d(0, 0, -back))});
       break;
     }
@@ -824,16 +834,19 @@ void LibraryCycle::enter(CycleState s) {
       // Not wider than the book needs: the right plate stands in the gap to the book placed before.
       start_gripper(false, lower_release_width(progress_.book_width, g));
       break;
-    case CycleState::kInsert:
-      start_linear({grasp_pose(gp_base_, grasp_geometry())});
+    case CycleState::kInsert: {
+      const CycleGeometry gw = grasp_geometry();
+      progress_.grasp_insertion_depth = gw.insertion_depth;  // persisted below: EXTRACT comes out as far
+      start_linear({grasp_pose(gp_base_, gw)});
       break;
+    }
     case CycleState::kCloseGripper:
     case CycleState::kGraspFromHolder:
       start_gripper(true);
       break;
     case CycleState::kExtract: {
       start_linear(extract_moves(arm_->end_effector, cart_frame(), tcp_height(),
-                                 moves_front_z(progress_.gp_grasp.z(), g) + grasp_geometry().insertion_depth, g));
+                                 moves_front_z(progress_.gp_grasp.z(), g) + inserted_depth(), g));
       break;
     }
     case CycleState::kMoveToHolder: {
@@ -1210,6 +1223,7 @@ void LibraryCycle::handle_grasp_decision(const DecisionEvent& d) {
   if (d.outcome == "GRASP" && d.valid) {
     gp_base_ = d.gp_base;
     progress_.gp_grasp = d.gp_grasp;
+    progress_.grasp_insertion_depth = std::numeric_limits<double>::quiet_NaN();  // set at INSERT
     message_ = d.reason;
     succeed(CycleState::kMoveToPreGrasp);
   } else if (d.outcome == "NEXT_REGION") {

@@ -331,6 +331,9 @@ class LibraryCycle {
   PlateOpening grasp_opening() const;
   /// The geometry with this attempt's plate_grasp() offset and insertion depth.
   CycleGeometry grasp_geometry() const;
+  /// How far beyond GP the plates went at this book's last INSERT (TaskProgress::grasp_insertion_depth), or
+  /// grasp_geometry()'s depth when it is not known (before INSERT, or after a restart from an older file).
+  double inserted_depth() const;
   void issue_plan();
   void drive_motion(const ArmEvent& e);
   /// After a move that carries the book: if the plates closed on nothing (no contact, narrower than
@@ -365,6 +368,10 @@ class LibraryCycle {
   void leave_on_holder(const std::string& why);
   /// Height of the book the planner is told about while it is held (GP.x).
   double held_box_height() const;
+  /// Depth of that book: held_book_depth_m, and while the book comes from the upper shelf, as much more as its grasp
+  /// went less deep than grasp.insertion_depth_m. The planner's box puts the fore-edge held_book.behind_tcp_m (the
+  /// nominal insertion) behind the TCP; after a shallower grasp the book's far end reaches that much further ahead.
+  double held_box_depth() const;
   /// BwH from the P1 check's or PS check's answer: its start point (P1 or PS) and the book front's Z.
   void start_bwh_from(const DecisionEvent& d);
   void handle_p1_check(const DecisionEvent& d);

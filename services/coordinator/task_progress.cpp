@@ -56,6 +56,7 @@ std::string progress_to_yaml(const TaskProgress& p) {
   e << YAML::Key << "gp_grasp" << YAML::Value << YAML::Flow << YAML::BeginSeq << p.gp_grasp.x() << p.gp_grasp.y()
     << p.gp_grasp.z() << YAML::EndSeq;
   e << YAML::Key << "book_width" << YAML::Value << p.book_width;
+  e << YAML::Key << "grasp_insertion_depth" << YAML::Value << p.grasp_insertion_depth;
   e << YAML::Key << "lower_next_right_y" << YAML::Value << p.lower_next_right_y;
   e << YAML::Key << "finished" << YAML::Value << p.finished;
   e << YAML::Key << "last_state" << YAML::Value << p.last_state;
@@ -87,6 +88,8 @@ TaskProgress progress_from_yaml(const std::string& text, const std::string& sour
   if (gp.size() != 3) throw std::runtime_error(source + ": gp_grasp must have 3 numbers");
   p.gp_grasp = Eigen::Vector3d(gp[0], gp[1], gp[2]);
   p.book_width = need<double>(n, "book_width", source);
+  // Absent before stop 38: recomputed from the plates' opening and GP.
+  if (n["grasp_insertion_depth"]) p.grasp_insertion_depth = need<double>(n, "grasp_insertion_depth", source);
   p.lower_next_right_y = need<double>(n, "lower_next_right_y", source);
   p.finished = need<bool>(n, "finished", source);
   p.last_state = need<std::string>(n, "last_state", source);

@@ -48,6 +48,10 @@ struct TaskProgress {
   bool have_book_data = false;            ///< gp_grasp and book_width below are set
   Eigen::Vector3d gp_grasp = Eigen::Vector3d::Zero();  ///< current book's GP, grasp frame
   double book_width = 0;                  ///< current book's width (plates), m
+  /// How far beyond GP the plates went at the current book's last INSERT, m (less than grasp.insertion_depth_m near
+  /// the right side panel): EXTRACT and BACK_OUT come out as far, and the planner's box for the held book reaches that
+  /// much further ahead. NaN before the first INSERT and in files written before stop 38 (then recomputed).
+  double grasp_insertion_depth = std::numeric_limits<double>::quiet_NaN();
   double lower_next_right_y = 0;          ///< right cover of the next book on the lower shelf, grasp Y
   bool finished = false;                  ///< the upper shelf is empty
   /// Non-empty: why the lower shelf could not take the current book; it goes back onto the holder for the librarian.

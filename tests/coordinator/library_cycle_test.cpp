@@ -550,16 +550,19 @@ TEST(LibraryCycle, ABookNearTheRightSidePanelIsGraspedWithThePalmClearOfIt) {
   ASSERT_NEAR(shipped.geometry.palm_behind_tcp, 0.0309, 1e-12);
   CycleSettings moved_left = shipped;
   moved_left.geometry.palm_behind_tcp = 0.0;
+  ASSERT_NEAR(shipped.held_book_depth_m, 0.30, 1e-12);
   struct Case {
     CycleSettings settings;
     double tcp_y, tcp_z;
     std::string said;
+    double held_box_depth;  // the planner's box for book 0 on its way to the holder: 14.1 mm deeper after 15.9 mm
   };
   for (const Case& c :
        {Case{shipped, 0.345, 0.0259,
              "the plates go 15.9 mm beyond GP, 14.1 mm less deep than grasp.insertion_depth_m: the palm "
-             "stays in front of the right side panel"},
-        Case{moved_left, 0.338, 0.04, "plates and palm 7.0 mm further left, clear of the right side panel"}}) {
+             "stays in front of the right side panel",
+             0.3141},
+        Case{moved_left, 0.338, 0.04, "plates and palm 7.0 mm further left, clear of the right side panel", 0.30}}) {
     std::vector<FakeBook> books = three_books();
     books[0].right_y = 0.36;
     FakeLibrary w(books);
@@ -579,7 +582,64 @@ TEST(LibraryCycle, ABookNearTheRightSidePanelIsGraspedWithThePalmClearOfIt) {
     const bool said = std::any_of(w.messages.begin(), w.messages.end(),
                                   [&](const std::string& m) { return m.find(c.said) != std::string::npos; });
     EXPECT_TRUE(said) << c.said;
+    std::vector<double> to_holder;  // the held book's depth in each plan to the holder, book by book
+    for (size_t i = 0; i < w.requests.size(); ++i)
+      if (w.requests[i].kind == CycleRequest::Kind::kPlan && w.requests_state[i] == "MOVE_TO_HOLDER")
+        to_holder.push_back(w.requests[i].book_size.z());
+    ASSERT_EQ(to_holder.size(), 3u) << c.said;
+    EXPECT_NEAR(to_holder[0], c.held_box_depth, 1e-4) << c.said;
+    EXPECT_NEAR(to_holder[1], 0.30, 1e-12) << c.said;
+    // From the holder to the lower shelf the plates hold it at the holder's grasp: the configured depth.
+    for (size_t i = 0; i < w.requests.size(); ++i) {
+      if (w.requests[i].kind == CycleRequest::Kind::kPlan && w.requests[i].holding_book &&
+          w.requests_state[i] != "MOVE_TO_HOLDER") {
+        EXPECT_NEAR(w.requests[i].book_size.z(), 0.30, 1e-12) << w.requests_state[i] << " " << c.said;
+      }
+    }
   }
+}
+
+TEST(LibraryCycle, ACoordinatorRestartedAfterAShallowGraspExtractsAndPlansWithItsDepth) {
+  // Book 0 near the right side panel, as above, with the corner servo's fore-edges: the plates' narrowed opening
+  // decides how deep they go. A restarted coordinator has no fore-edges, so its opening, and the depth it would
+  // compute, differ; the depth of the INSERT that happened is persisted, and EXTRACT and the plan to the holder use it.
+  const auto run_book_0 = [](bool restart) {
+    std::vector<FakeBook> books = three_books();
+    books[0].right_y = 0.348;
+    FakeLibrary w(books);
+    w.servo_measures_width = true;
+    auto first = std::make_unique<LibraryCycle>(settings(), std::nullopt);
+    w.run(*first, [&] { return first->state() == CycleState::kExtract; });
+    std::unique_ptr<LibraryCycle> second;
+    if (restart) {
+      const auto progress = bookgrasp::progress_from_yaml(bookgrasp::progress_to_yaml(first->progress()), "restart");
+      first.reset();
+      second = std::make_unique<LibraryCycle>(settings(), progress);
+    } else {
+      second = std::move(first);
+    }
+    const size_t from = w.requests.size();
+    w.run(*second, [&] { return second->state() == CycleState::kWaitUser || done_or_aborted(*second); });
+    Eigen::Vector3d extracted = Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
+    for (const auto& [state, p] : w.tcp_path)
+      if (state == "EXTRACT") extracted = hand_grasp_frame().inverse() * p;  // the TCP where EXTRACT ended
+    EXPECT_EQ(second->state(), CycleState::kWaitUser) << second->status().message;
+    double depth = std::numeric_limits<double>::quiet_NaN();
+    for (size_t i = from; i < w.requests.size(); ++i)
+      if (w.requests[i].kind == CycleRequest::Kind::kPlan && w.requests_state[i] == "MOVE_TO_HOLDER")
+        depth = w.requests[i].book_size.z();
+    return std::tuple{second->progress().grasp_insertion_depth, depth, extracted};
+  };
+  const auto [inserted, box, extracted] = run_book_0(false);
+  ASSERT_TRUE(std::isfinite(inserted));
+  EXPECT_LT(inserted, 0.03 - 0.001) << "book 0 is grasped less deep than grasp.insertion_depth_m";
+  EXPECT_NEAR(box, 0.30 + 0.03 - inserted, 1e-9);
+  const auto [inserted_restarted, box_restarted, extracted_restarted] = run_book_0(true);
+  EXPECT_EQ(inserted_restarted, inserted);
+  EXPECT_EQ(box_restarted, box);
+  EXPECT_LT((extracted_restarted - extracted).norm(), 1e-3)
+      << "EXTRACT ends at " << extracted_restarted.transpose() << " after the restart, at " << extracted.transpose()
+      << " without";
 }
 
 TEST(LibraryCycle, TheShippedPlateCheckSeparatesTheMeasuredGraspsFromTheDoubleLifts) {
@@ -1263,6 +1323,7 @@ TEST(TaskProgress, RoundTripAndCorruptFilesAreNamed) {
   p.have_book_data = true;
   p.gp_grasp = Eigen::Vector3d(0.25, 0.3, 0.01);
   p.book_width = 0.025;
+  p.grasp_insertion_depth = 0.0159;
   p.lower_next_right_y = 0.34;
   p.last_state = "WAIT_USER";
   p.hand_over_reason = "MOVE_TO_LOWER_SHELF failed 3 times";
@@ -1290,6 +1351,8 @@ TEST(TaskProgress, RoundTripAndCorruptFilesAreNamed) {
   EXPECT_EQ(q.place, BookPlace::kOnHolder);
   EXPECT_EQ(q.gp_grasp, p.gp_grasp);
   EXPECT_EQ(q.book_width, 0.025);
+  EXPECT_EQ(q.grasp_insertion_depth, 0.0159);
+  EXPECT_TRUE(std::isnan(old.grasp_insertion_depth)) << "a file from before stop 38 has no insertion depth";
   EXPECT_EQ(q.last_state, "WAIT_USER");
   EXPECT_EQ(q.moved[0].lower_right_y, 0.37);
   EXPECT_THROW(bookgrasp::progress_from_yaml("books_moved: 1\n", "x"), std::runtime_error);
