@@ -47,6 +47,7 @@ CycleGeometry CycleGeometry::from_config(const Config& c) {
   g.left_plate_min_clearance = c.get_double("grasp.left_plate_min_clearance_m", 0.0, 0.05);
   g.more_than_the_book = c.get_double("grasp.more_than_the_book_m", 0.0, 0.05);
   g.retry_left_clearance = c.get_double("grasp.retry_left_clearance_m", 0.0005, 0.05);  // > 0: a narrower opening
+  g.split_fore_edge_gap = c.get_double("grasp.split_fore_edge_gap_m", 0.0, 0.01);
   g.palm_half_width = c.get_double("grasp.palm_half_width_m", 0.0, 0.2);
   g.right_panel_clearance = c.get_double("grasp.right_panel_clearance_m", 0.0, 0.05);
   g.right_plate_min_clearance = c.get_double("grasp.right_plate_min_clearance_m", 0.0, 0.05);
@@ -215,6 +216,15 @@ PlateGrasp plate_grasp_clear_of_right_panel(const PlateOpening& o, const Eigen::
       return {o, std::min(g.insertion_depth, palm_in_front)};
   }
   return {plate_opening_clear_of_right_panel(o, gp.y(), open_width, g), g.insertion_depth};
+}
+
+ForeEdges join_split_fore_edge(const ForeEdges& reported, const CycleGeometry& g) {
+  const auto measured = [](double v) { return std::isfinite(v) && v > 0; };
+  if (!(g.split_fore_edge_gap > 0) || !measured(reported.front_width) || !measured(reported.neighbour_offset) ||
+      !measured(reported.neighbour_width))
+    return reported;
+  if (reported.neighbour_offset - reported.front_width >= g.split_fore_edge_gap) return reported;
+  return ForeEdges{reported.neighbour_offset + reported.neighbour_width, 0.0, 0.0};
 }
 
 bool holds_more_than_the_book(double plate_distance, const ForeEdges& edges, const CycleGeometry& g) {

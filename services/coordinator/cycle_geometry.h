@@ -55,6 +55,9 @@ struct CycleGeometry {
   /// open the plates only to the fore-edge + retry_left_clearance. 0 = no check.
   double more_than_the_book = 0.0;
   double retry_left_clearance = 0.005;  ///< see more_than_the_book
+  /// Not in the paper: the corner servo's fore-edge and the next one to its left closer than this are one page face
+  /// that a dark page line split (join_split_fore_edge). 0 = never joined.
+  double split_fore_edge_gap = 0.0;
   /// Not in the paper: the palm's half width across the books (Y). With it > 0, a right-most book near the right
   /// side panel (shelf_right_y) gets the plates and the palm moved left together, so that the palm stays
   /// right_panel_clearance left of the panel (plate_opening_clear_of_right_panel). 0 = no such shift.
@@ -67,7 +70,7 @@ struct CycleGeometry {
   /// edge (side_panel_front_z), but at least min_insertion_depth (plate_grasp_clear_of_right_panel). 0 = the move left
   /// only.
   double palm_behind_tcp = 0.0;
-  double min_insertion_depth = 0.01;  ///< see palm_behind_tcp
+  double min_insertion_depth = 0.005;  ///< see palm_behind_tcp (coordinator.yaml: 0.005)
   double side_panel_front_z = 0.0;    ///< grasp Z of the side panels' front edges
   double pre_grasp_distance = 0.10; ///< pre-grasp pose this far in front of GP along -Z
   /// Deepest GP (grasp Z) the pre-grasp and the extraction's end are measured from: a deeper front (books
@@ -155,6 +158,14 @@ struct ForeEdges {
   double neighbour_offset = 0.0;  ///< how far left of R the next fore-edge's right edge lies
   double neighbour_width = 0.0;   ///< the next fore-edge's width
 };
+
+/// `reported` with a split page face joined. Two books' page faces are separated by both their covers (2 mm in the
+/// simulated books, more on real hard covers); a dark line of the page texture can split one page face into two
+/// fore-edges that touch. So when the next fore-edge's right edge lies less than g.split_fore_edge_gap left of the
+/// target's left edge (neighbour_offset - front_width), the target's fore-edge reaches the next one's left edge
+/// (front_width = neighbour_offset + neighbour_width) and the next fore-edge beyond is not known (neighbour 0).
+/// Unchanged when either is not measured or split_fore_edge_gap is 0.
+ForeEdges join_split_fore_edge(const ForeEdges& reported, const CycleGeometry& g);
 
 /// The plates' opening for the fore-edges `edges` with the gripper's full opening `open_width`. The right plate's
 /// inner face stays open_width / 2 + grasp_offset_y right of GP. The left one's inner face goes, with

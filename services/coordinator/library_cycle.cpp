@@ -778,7 +778,7 @@ void LibraryCycle::enter(CycleState s) {
       r.kind = CycleRequest::Kind::kServo;
       r.id = next_id();
       servo_request_ = r.id;
-      fore_edges_ = ForeEdges{};
+      fore_edges_ = servo_fore_edges_ = ForeEdges{};
       r.servo_mode = kServoBookCorner;
       r.pose = arm_ ? arm_->end_effector : bwh_start_pose(cart_frame(), bwh_start_, g);
       r.rank = rank_;
@@ -807,6 +807,11 @@ void LibraryCycle::enter(CycleState s) {
       const double shift = book_opening().offset_y - opening.offset_y;
       const double over = palm_over_right_panel(opening, progress_.gp_grasp.y(), s_.geometry);
       const double shallower = g.insertion_depth - gw.insertion_depth;
+      if (fore_edges_.front_width != servo_fore_edges_.front_width)
+        message_ += "; the corner servo's fore-edge " + mm(servo_fore_edges_.front_width) + " and the next, " +
+                    mm(servo_fore_edges_.neighbour_width) + ", touch (" +
+                    mm(servo_fore_edges_.neighbour_offset - servo_fore_edges_.front_width) +
+                    " apart < grasp.split_fore_edge_gap_m): one fore-edge " + mm(fore_edges_.front_width) + " wide";
       if (shallower > 1e-4)
         message_ += "; the plates go " + mm(gw.insertion_depth) + " beyond GP, " + mm(shallower) +
                     " less deep than grasp.insertion_depth_m: the palm stays in front of the right side panel";
@@ -1281,7 +1286,10 @@ std::vector<CycleRequest> LibraryCycle::on_servo(const ServoEvent& e) {
     else
       fail("stripe servo ended " + servo_state_name(e.state) + (e.message.empty() ? "" : ": " + e.message));
   } else if (state_ == CycleState::kServoBook && e.request_id == servo_request_ && terminal) {
-    if (e.state == kServoConverged) fore_edges_ = {e.front_width_m, e.neighbour_offset_m, e.neighbour_width_m};
+    if (e.state == kServoConverged) {
+      servo_fore_edges_ = {e.front_width_m, e.neighbour_offset_m, e.neighbour_width_m};
+      fore_edges_ = join_split_fore_edge(servo_fore_edges_, s_.geometry);
+    }
     // Converged or not, the arbiter decides (a failed BwH servo is its NO_GRASP).
     succeed(CycleState::kWaitDecision);
   }

@@ -415,7 +415,8 @@ class LibraryCycle {
       0.0;  ///< grasp Z of the book's front for the corner servo: P1.z when P1 is valid, else the model's
   std::optional<DecisionEvent> early_decision_;  ///< a decision that arrived before its servo status
   Eigen::Isometry3d gp_base_ = Eigen::Isometry3d::Identity();
-  ForeEdges fore_edges_;  ///< this attempt's fore-edges as the corner servo measured them (0 = not measured)
+  ForeEdges fore_edges_;        ///< this attempt's fore-edges (0 = not measured), a split page face joined
+  ForeEdges servo_fore_edges_;  ///< ... as the corner servo reported them
   /// An earlier grasp of this book closed on more than it (geometry.more_than_the_book): open only so far now.
   bool narrow_after_more_than_the_book_ = false;
   bool user_event_sent_ = false;

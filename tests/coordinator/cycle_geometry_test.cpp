@@ -357,5 +357,30 @@ TEST(CycleGeometry, ADiagonalLiftEndsOutAndUpInOneLineAndTheRetreatStaysWithin) 
   EXPECT_NEAR(further.z(), -0.10, 1e-12);
 }
 
+TEST(CycleGeometry, AForeEdgeTouchingTheNextIsOnePageFace) {
+  CycleGeometry g;
+  g.split_fore_edge_gap = 0.0005;
+  // Seed 5050: 19.7 mm, and the next fore-edge 19.7 mm left of R, 8.6 mm wide: one 28.3 mm fore-edge, none beyond.
+  const ForeEdges joined = join_split_fore_edge({0.0197, 0.0197, 0.0086}, g);
+  EXPECT_NEAR(joined.front_width, 0.0283, 1e-12);
+  EXPECT_EQ(joined.neighbour_offset, 0.0);
+  EXPECT_EQ(joined.neighbour_width, 0.0);
+  EXPECT_NEAR(join_split_fore_edge({0.0197, 0.0201, 0.0086}, g).front_width, 0.0287, 1e-12);  // 0.4 mm apart
+  // Two books: both covers between their page faces (the nearest seen, 1.5 mm), or just over the key.
+  for (const double gap : {0.0015, 0.0006}) {
+    const ForeEdges two{0.0197, 0.0197 + gap, 0.0086};
+    const ForeEdges kept = join_split_fore_edge(two, g);
+    EXPECT_EQ(kept.front_width, two.front_width) << gap;
+    EXPECT_EQ(kept.neighbour_offset, two.neighbour_offset) << gap;
+    EXPECT_EQ(kept.neighbour_width, two.neighbour_width) << gap;
+  }
+  // Nothing to join: no next fore-edge, no width, the key 0.
+  EXPECT_EQ(join_split_fore_edge({0.0197, 0.0, 0.0}, g).front_width, 0.0197);
+  EXPECT_EQ(join_split_fore_edge({0.0, 0.0197, 0.0086}, g).front_width, 0.0);
+  EXPECT_EQ(join_split_fore_edge({std::nan(""), 0.0197, 0.0086}, g).neighbour_width, 0.0086);
+  g.split_fore_edge_gap = 0.0;
+  EXPECT_EQ(join_split_fore_edge({0.0197, 0.0197, 0.0086}, g).front_width, 0.0197);
+}
+
 }  // namespace
 }  // namespace bookgrasp

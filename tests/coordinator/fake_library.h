@@ -87,6 +87,9 @@ class FakeLibrary {
   bool servo_silent = false;                 ///< servo never answers (timeouts)
   bool servo_measures_width = false;         ///< the corner servo's CONVERGED carries the right-most book's width
                                              ///< (and, with a book left of it, that book's offset and width)
+  /// > 0 (with servo_measures_width): the right-most book's page face is split this far left of R by a dark page
+  /// line: the servo reports a fore-edge this wide and the rest of it as the next fore-edge, touching
+  double servo_splits_front_at = 0.0;
   /// > 0: the stripe servo never finds an end and moves the TCP left (grasp -Y) at this speed (m/s) until it is
   /// cancelled or the arm stopped (a free stripe running out of the image on the left)
   double stripe_runs_left_m_s = 0.0;
@@ -381,6 +384,11 @@ class FakeLibrary {
           if (r.servo_mode == 1 && servo_measures_width && upper.size() > 1) {  // the next fore-edge to the left
             s.neighbour_offset_m = upper[0].right_y - upper[1].right_y;
             s.neighbour_width_m = upper[1].width;
+          }
+          if (r.servo_mode == 1 && servo_measures_width && servo_splits_front_at > 0 && !upper.empty()) {
+            s.front_width_m = servo_splits_front_at;
+            s.neighbour_offset_m = servo_splits_front_at;
+            s.neighbour_width_m = upper.front().width - servo_splits_front_at;
           }
           answers.push_back([&cycle, s] { return cycle.on_servo(s); });
           if (r.servo_mode == 2) {  // STRIPE_END: PS where the right-most book hides the stripe

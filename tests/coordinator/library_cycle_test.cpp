@@ -488,6 +488,49 @@ TEST(LibraryCycle, AForeEdgeWidthFromTheCornerServoOpensThePlatesOnlySoFar) {
   }
 }
 
+TEST(LibraryCycle, AForeEdgeSplitByAPageLineOpensThePlatesToTheWholeBook) {
+  // Seed 5050's case: the corner servo reports the 25 mm book 0 (three_books()) as an 18 mm fore-edge and a 7 mm one
+  // touching it. coordinator.yaml: split_fore_edge_gap_m 0.5 mm, width_left_clearance_m 5 mm, the right plate 15 mm
+  // right of GP. Joined, the plates open to 15 + 25 + 5 mm; taken as reported, to 15 + 18 + 5 mm, the left plate lands
+  // on the book, and the plates close 7 mm wider than the 18 mm fore-edge: a double lift by the plate check
+  // (more_than_the_book_m 2.5 mm), an attempt lost.
+  const CycleSettings shipped = settings();
+  ASSERT_NEAR(shipped.geometry.split_fore_edge_gap, 0.0005, 1e-12);
+  ASSERT_NEAR(shipped.geometry.width_left_clearance, 0.005, 1e-12);
+  ASSERT_NEAR(three_books()[0].width, 0.025, 1e-12);
+  CycleSettings unjoined = shipped;
+  unjoined.geometry.split_fore_edge_gap = 0.0;
+  for (const auto& [cs, opening, joined] : {std::tuple{shipped, 0.045, true}, std::tuple{unjoined, 0.038, false}}) {
+    SCOPED_TRACE("split_fore_edge_gap " + std::to_string(cs.geometry.split_fore_edge_gap));
+    FakeLibrary w(three_books());
+    w.servo_measures_width = true;
+    w.servo_splits_front_at = 0.018;
+    LibraryCycle cycle(cs, std::nullopt);
+    w.run(cycle, [&] { return cycle.progress().books_moved == 1 || done_or_aborted(cycle); });
+    std::vector<double> openings;
+    for (size_t i = 0; i < w.requests.size(); ++i)
+      if (w.requests[i].kind == CycleRequest::Kind::kGripperMove && w.requests_state[i] == "OPEN_FOR_GRASP")
+        openings.push_back(w.requests[i].width);
+    ASSERT_FALSE(openings.empty());
+    EXPECT_NEAR(openings[0], opening, 1e-9);
+    const auto said = [&](const std::string& text) {
+      return std::any_of(w.messages.begin(), w.messages.end(),
+                         [&](const std::string& m) { return m.find(text) != std::string::npos; });
+    };
+    if (joined) {
+      EXPECT_EQ(cycle.progress().books_moved, 1) << cycle.status().message;
+      EXPECT_EQ(cycle.progress().failures, 0) << cycle.status().message;
+      EXPECT_TRUE(
+          said("the corner servo's fore-edge 18.0 mm and the next, 7.0 mm, touch (0.0 mm apart < "
+               "grasp.split_fore_edge_gap_m): one fore-edge 25.0 mm wide"));
+    } else {
+      // Every attempt sees the same split here, so the book is never taken.
+      EXPECT_GE(cycle.progress().failures, 1);
+      EXPECT_TRUE(said("the plates closed to 25.0 mm on a fore-edge 18.0 mm wide: more than the book"));
+    }
+  }
+}
+
 TEST(LibraryCycle, PlatesClosedOnMoreThanTheBookTryAgainOpenedToTheBookOnly) {
   // coordinator.yaml: more_than_the_book_m 2.5 mm, retry_left_clearance_m 5 mm. three_books(): book 0 25 mm wide, book
   // 1 20 mm, 2 mm apart: a close on both stops at 47 mm.
@@ -692,6 +735,7 @@ TEST(LibraryCycle, BadDepthKeysNameTheKey) {
         {"grasp.retry_left_clearance_m", "retry_left_clearance_m: 0.005", "retry_left_clearance_m: 0.0"},
         {"grasp.more_than_the_book_m", "more_than_the_book_m: 0.0025", "more_than_the_book_m: 0.2"},
         {"grasp.width_left_clearance_m", "width_left_clearance_m: 0.005", "width_left_clearance_m: 0.2"},
+        {"grasp.split_fore_edge_gap_m", "split_fore_edge_gap_m: 0.0005", "split_fore_edge_gap_m: -0.001"},
         {"grasp.palm_behind_tcp_m", "palm_behind_tcp_m: 0.0309", "palm_behind_tcp_m: -0.03"},
         // Deeper than insertion_depth_m (0.03): the shallower grasp near the panel would go deeper.
         {"grasp.min_insertion_depth_m", "min_insertion_depth_m: 0.005", "min_insertion_depth_m: 0.05"},
