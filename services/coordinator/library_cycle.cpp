@@ -855,6 +855,9 @@ void LibraryCycle::enter(CycleState s) {
       break;
     }
     case CycleState::kMoveToHolder: {
+      if (const double deeper = held_box_depth() - s_.held_book_depth_m; deeper > 1e-4)
+        message_ += "; the planner's box for the book " + mm(deeper) +
+                    " deeper than held_book_depth_m: the plates went in that much less deep";
       // PLACE_ON_HOLDER and RETREAT_FROM_HOLDER follow.
       // A book going back to the holder (return_to_holder) sits lower in the plates: its grasp from the holder's.
       std::vector<Eigen::Isometry3d> then = holder_place_moves(holder_frame(), holder_tcp_height(), g);

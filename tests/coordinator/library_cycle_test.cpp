@@ -631,6 +631,10 @@ TEST(LibraryCycle, ABookNearTheRightSidePanelIsGraspedWithThePalmClearOfIt) {
         to_holder.push_back(w.requests[i].book_size.z());
     ASSERT_EQ(to_holder.size(), 3u) << c.said;
     EXPECT_NEAR(to_holder[0], c.held_box_depth, 1e-4) << c.said;
+    const bool box_said = std::any_of(w.messages.begin(), w.messages.end(), [](const std::string& m) {
+      return m.find("the planner's box for the book 14.1 mm deeper than held_book_depth_m") != std::string::npos;
+    });
+    EXPECT_EQ(box_said, c.held_box_depth > 0.30) << c.said;
     EXPECT_NEAR(to_holder[1], 0.30, 1e-12) << c.said;
     // From the holder to the lower shelf the plates hold it at the holder's grasp: the configured depth.
     for (size_t i = 0; i < w.requests.size(); ++i) {
