@@ -807,7 +807,7 @@ void LibraryCycle::enter(CycleState s) {
       const double shift = book_opening().offset_y - opening.offset_y;
       const double over = palm_over_right_panel(opening, progress_.gp_grasp.y(), s_.geometry);
       const double shallower = g.insertion_depth - gw.insertion_depth;
-      if (fore_edges_.front_width != servo_fore_edges_.front_width)
+      if (std::isfinite(servo_fore_edges_.front_width) && fore_edges_.front_width != servo_fore_edges_.front_width)
         message_ += "; the corner servo's fore-edge " + mm(servo_fore_edges_.front_width) + " and the next, " +
                     mm(servo_fore_edges_.neighbour_width) + ", touch (" +
                     mm(servo_fore_edges_.neighbour_offset - servo_fore_edges_.front_width) +

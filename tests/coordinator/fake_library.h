@@ -90,6 +90,9 @@ class FakeLibrary {
   /// > 0 (with servo_measures_width): the right-most book's page face is split this far left of R by a dark page
   /// line: the servo reports a fore-edge this wide and the rest of it as the next fore-edge, touching
   double servo_splits_front_at = 0.0;
+  /// Set: the corner servo's CONVERGED carries this fore-edge width (NaN: a malformed report) and its next fore-edge
+  /// touching it, as wide
+  std::optional<double> servo_front_width;
   /// > 0: the stripe servo never finds an end and moves the TCP left (grasp -Y) at this speed (m/s) until it is
   /// cancelled or the arm stopped (a free stripe running out of the image on the left)
   double stripe_runs_left_m_s = 0.0;
@@ -390,6 +393,8 @@ class FakeLibrary {
             s.neighbour_offset_m = servo_splits_front_at;
             s.neighbour_width_m = upper.front().width - servo_splits_front_at;
           }
+          if (r.servo_mode == 1 && servo_front_width)
+            s.front_width_m = s.neighbour_offset_m = s.neighbour_width_m = *servo_front_width;
           answers.push_back([&cycle, s] { return cycle.on_servo(s); });
           if (r.servo_mode == 2) {  // STRIPE_END: PS where the right-most book hides the stripe
             ps = Eigen::Vector3d(0.10, upper.empty() ? -0.395 : upper.front().right_y, -0.10);

@@ -529,6 +529,18 @@ TEST(LibraryCycle, AForeEdgeSplitByAPageLineOpensThePlatesToTheWholeBook) {
       EXPECT_TRUE(said("the plates closed to 25.0 mm on a fore-edge 18.0 mm wide: more than the book"));
     }
   }
+  // A report whose widths are NaN joins nothing, says nothing of it, and leaves the plates fully open.
+  FakeLibrary w(three_books());
+  w.servo_front_width = std::numeric_limits<double>::quiet_NaN();
+  LibraryCycle cycle(shipped, std::nullopt);
+  w.run(cycle, [&] { return cycle.progress().books_moved == 1 || done_or_aborted(cycle); });
+  EXPECT_EQ(cycle.progress().books_moved, 1) << cycle.status().message;
+  for (size_t i = 0; i < w.requests.size(); ++i) {
+    if (w.requests[i].kind == CycleRequest::Kind::kGripperMove && w.requests_state[i] == "OPEN_FOR_GRASP") {
+      EXPECT_NEAR(w.requests[i].width, 0.06, 1e-12);
+    }
+  }
+  for (const std::string& m : w.messages) EXPECT_EQ(m.find("touch ("), std::string::npos) << m;
 }
 
 TEST(LibraryCycle, PlatesClosedOnMoreThanTheBookTryAgainOpenedToTheBookOnly) {
