@@ -28,6 +28,7 @@ cv::Mat histogram(const std::vector<double>& v, double lo, double hi, int bins, 
   const int W = 640, H = 400, L = 60, R = 20, T = 40, B = 60;
   cv::Mat img(H, W, CV_8UC3, cv::Scalar(255, 255, 255));
   std::vector<int> count(bins, 0);
+  const long over = std::count_if(v.begin(), v.end(), [&](double x) { return x > hi; });
   for (double x : v) {
     int k = static_cast<int>(std::floor((x - lo) / (hi - lo) * bins));
     k = std::clamp(k, 0, bins - 1);
@@ -49,11 +50,18 @@ cv::Mat histogram(const std::vector<double>& v, double lo, double hi, int bins, 
   for (int i = 0; i <= 4; ++i) {
     const double x = lo + (hi - lo) * i / 4;
     const int px = static_cast<int>(L + (W - L - R) * i / 4.0);
-    cv::putText(img, f2(x, "%.3g"), cv::Point(px - 12, H - B + 18), cv::FONT_HERSHEY_SIMPLEX, 0.4, cv::Scalar(0, 0, 0));
+    // Centred on its tick, but inside the image (the last one was cut at the right edge: "2e+0").
+    const std::string label = f2(x, "%.3g");
+    const int width = cv::getTextSize(label, cv::FONT_HERSHEY_SIMPLEX, 0.4, 1, nullptr).width;
+    cv::putText(img, label, cv::Point(std::clamp(px - width / 2, 2, W - width - 2), H - B + 18), cv::FONT_HERSHEY_SIMPLEX,
+                0.4, cv::Scalar(0, 0, 0));
   }
   cv::putText(img, std::to_string(cmax), cv::Point(8, T + 10), cv::FONT_HERSHEY_SIMPLEX, 0.4, cv::Scalar(0, 0, 0));
   cv::putText(img, title + "  (n = " + std::to_string(v.size()) + ")", cv::Point(L, 25), cv::FONT_HERSHEY_SIMPLEX, 0.55,
               cv::Scalar(0, 0, 0), 1, cv::LINE_AA);
+  if (over > 0)  // values beyond hi are counted in the last bar: say how many
+    cv::putText(img, std::to_string(over) + " over " + f2(hi, "%.3g") + ", in the last bar", cv::Point(W - R - 150, T - 3),
+                cv::FONT_HERSHEY_SIMPLEX, 0.4, cv::Scalar(0, 0, 200), 1, cv::LINE_AA);
   cv::putText(img, xlabel, cv::Point(L + 150, H - 15), cv::FONT_HERSHEY_SIMPLEX, 0.5, cv::Scalar(0, 0, 0), 1,
               cv::LINE_AA);
   return img;
