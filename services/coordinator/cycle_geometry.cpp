@@ -19,6 +19,11 @@ Eigen::Vector3d vec3(const Config& c, const std::string& key, double limit = 5.0
   return e;
 }
 
+/// A width or offset the corner servo measured (<= 0 or not finite: not measured).
+bool measured(double v) {
+  return std::isfinite(v) && v > 0;
+}
+
 }  // namespace
 
 CycleGeometry CycleGeometry::from_config(const Config& c) {
@@ -163,7 +168,6 @@ Eigen::Isometry3d grasp_pose(const Eigen::Isometry3d& gp, const CycleGeometry& g
 
 PlateOpening plate_opening(const ForeEdges& edges, double open_width, const CycleGeometry& g) {
   const PlateOpening full{open_width, g.grasp_offset_y};
-  const auto measured = [](double v) { return std::isfinite(v) && v > 0; };
   if (!measured(edges.front_width)) return full;
   double left = 0;  // the left plate's inner face, left of GP
   if (g.left_plate_on_neighbour && measured(edges.neighbour_offset) && measured(edges.neighbour_width))
@@ -219,7 +223,6 @@ PlateGrasp plate_grasp_clear_of_right_panel(const PlateOpening& o, const Eigen::
 }
 
 ForeEdges join_split_fore_edge(const ForeEdges& reported, const CycleGeometry& g) {
-  const auto measured = [](double v) { return std::isfinite(v) && v > 0; };
   if (!(g.split_fore_edge_gap > 0) || !measured(reported.front_width) || !measured(reported.neighbour_offset) ||
       !measured(reported.neighbour_width))
     return reported;
@@ -228,7 +231,7 @@ ForeEdges join_split_fore_edge(const ForeEdges& reported, const CycleGeometry& g
 }
 
 bool holds_more_than_the_book(double plate_distance, const ForeEdges& edges, const CycleGeometry& g) {
-  return g.more_than_the_book > 0 && std::isfinite(edges.front_width) && edges.front_width > 0 &&
+  return g.more_than_the_book > 0 && measured(edges.front_width) &&
          plate_distance > edges.front_width + g.more_than_the_book;
 }
 

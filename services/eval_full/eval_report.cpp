@@ -28,8 +28,9 @@ cv::Mat histogram(const std::vector<double>& v, double lo, double hi, int bins, 
   const int W = 640, H = 400, L = 60, R = 20, T = 40, B = 60;
   cv::Mat img(H, W, CV_8UC3, cv::Scalar(255, 255, 255));
   std::vector<int> count(bins, 0);
-  const long over = std::count_if(v.begin(), v.end(), [&](double x) { return x > hi; });
+  long over = 0;  // values beyond hi, counted in the last bar
   for (double x : v) {
+    over += x > hi;
     int k = static_cast<int>(std::floor((x - lo) / (hi - lo) * bins));
     k = std::clamp(k, 0, bins - 1);
     ++count[k];
