@@ -82,6 +82,7 @@ ArbiterSettings ArbiterSettings::from_config(const Config& root) {
   s.tolerances.hand_corner_max_y_from_p2 = root.get_double("hand_corner.max_y_from_p2_m", 0.0, 0.1);
   s.tolerances.p2_ps_y = root.get_double("tolerances.p2_measured_ps_y_m", 0.0, 0.2);
   s.tolerances.raised_bwh_start_x = root.get_double("tolerances.raised_bwh_start_m", 0.0, 0.3);
+  s.tolerances.raise_over_neighbour_corner = root.get<bool>("tolerances.raise_over_neighbour_corner");
   s.tolerances.invalid_p1_over_p2 = root.get<bool>("tolerances.invalid_p1_over_p2");
   s.use_stereo_front = root.get<bool>("stereo_front.enabled");
   const std::vector<double> band = root.get_vector("stereo_front.probe_left_of_ps_m", 2);
@@ -399,6 +400,7 @@ void ArbiterNode::decide(const servo_status_t& msg) {
     case GraspOutcome::kRaiseBwhStart:
       m.reason = "RAISE_BWH_START: " + last;
       raised_at_ps_ = ps_;
+      raised_over_corner_ = to_base(*in.p2);
       open_attempt();
       break;
     case GraspOutcome::kStartFromP1:
@@ -424,6 +426,7 @@ CombinationInputs ArbiterNode::common_inputs() const {
   in.ps_measured = ps_measured_;
   in.p1_led_astray = same_stripe_end(p1_astray_at_ps_, *ps_);
   in.bwh_start_raised = same_stripe_end(raised_at_ps_, *ps_);
+  if (in.bwh_start_raised && raised_over_corner_) in.neighbour_corner_x = to_grasp(*raised_over_corner_).x();
   in.p1_between = same_stripe_end(p1_between_at_ps_, *ps_);
   if (corner_at_ps_ && corner_at_ps_->ps == *ps_) in.earlier_corner_z = corner_at_ps_->z;
   in.front_z_fallback = s_.book_front_z;

@@ -139,6 +139,8 @@ class ArbiterNode : public Component {
   /// The PS (base) at which BwH from PS found a shorter left neighbour's corner (GraspOutcome::kRaiseBwhStart): at
   /// the same PS (within 3 mm), BwH starts higher.
   std::optional<Eigen::Vector3d> raised_at_ps_;
+  /// The shorter neighbour's corner (P2, base) that BwH from raised_at_ps_ found: the raised start lies above it.
+  std::optional<Eigen::Vector3d> raised_over_corner_;
   /// The PS (base) at which BwH from PS found a corner left of and below a P1 on PS's left (GraspOutcome::
   /// kStartFromP1): at the same PS (within 3 mm), such a P1 is used.
   std::optional<Eigen::Vector3d> p1_between_at_ps_;

@@ -118,10 +118,15 @@ CombinationResult validate_p1_against_ps(const CombinationInputs& in, const Comb
 CombinationResult validate_p1(const CombinationInputs& in, const CombinationTolerances& tol) {
   CombinationResult r = validate_p1_against_ps(in, tol);
   if (r.p1_valid || !in.bwh_start_raised || !(tol.raised_bwh_start_x > 0) || !r.bwh_start.allFinite()) return r;
-  r.bwh_start.x() += tol.raised_bwh_start_x;
-  r.steps.push_back(step("BwH start raised", tol.raised_bwh_start_x, tol.raised_bwh_start_x, true,
+  const double ps_x = r.bwh_start.x();
+  const bool over_corner = tol.raise_over_neighbour_corner && in.neighbour_corner_x &&
+                           std::isfinite(*in.neighbour_corner_x) && *in.neighbour_corner_x > ps_x;
+  r.bwh_start.x() = (over_corner ? *in.neighbour_corner_x : ps_x) + tol.raised_bwh_start_x;
+  const std::string above =
+      over_corner ? " above that corner (" + mm(r.bwh_start.x() - ps_x) + " above PS)" : " higher";
+  r.steps.push_back(step("BwH start raised", r.bwh_start.x() - ps_x, tol.raised_bwh_start_x, true,
                          "BwH from PS found a shorter left neighbour's corner at this PS before: it starts " +
-                             mm(tol.raised_bwh_start_x) + " higher, where a tall right-most book's corner lies"));
+                             mm(tol.raised_bwh_start_x) + above + ", where a tall right-most book's corner lies"));
   return r;
 }
 

@@ -48,6 +48,12 @@ struct CombinationTolerances {
   /// Once raised, such a P2 again gets no grasp (kNoGrasp: a failed attempt; the next one starts raised as well).
   /// 0 = off (the paper accepts such a P2). Needs p2_ps_y > 0.
   double raised_bwh_start_x = 0.0;
+  /// Not in the paper: the raised start lies raised_bwh_start_x above the shorter neighbour's corner BwH found
+  /// (CombinationInputs::neighbour_corner_x) when that is higher than PS, not above PS. The right-most book is
+  /// taller than that neighbour; PS at the stripe's height says nothing about how much (far_cart seed 5273: the
+  /// 290 mm book's corner 73 mm above PS + 100 mm, out of the hand camera's view; the 186 mm neighbour's taken
+  /// again). False: above PS alone.
+  bool raise_over_neighbour_corner = true;
   /// Not in the paper: without a valid P1, a P2 more than `y` left of and more than `x` below a P1 that failed the PS
   /// check on its left is a shorter left neighbour's corner: P1's book stands between it and PS. The right-most book
   /// is tall and leans left (its top corner fails the check against PS, which lies at the stripe's height) and its
@@ -115,6 +121,9 @@ struct CombinationInputs {
   /// At this PS, BwH from PS (no valid P1) found a corner more than CombinationTolerances::p2_ps_y left of it before:
   /// BwH starts CombinationTolerances::raised_bwh_start_x higher.
   bool bwh_start_raised = false;
+  /// X (grasp frame) of the shorter left neighbour's corner (P2) that BwH from PS found at this PS before, with
+  /// bwh_start_raised (CombinationTolerances::raise_over_neighbour_corner).
+  std::optional<double> neighbour_corner_x;
   /// At this PS, BwH from PS found a corner left of and below a P1 that failed the PS check on its left before
   /// (CombinationTolerances::invalid_p1_over_p2): such a P1 is taken as valid, its book standing between.
   bool p1_between = false;
@@ -142,7 +151,8 @@ std::optional<double> front_depth_without_p1(const CombinationInputs& in, const 
                                              ValidationStep* step);
 
 /// Step 1 only (Section 3.1): is P1 valid against PS, and where BwH starts. Not in the paper: without a valid P1
-/// and with in.bwh_start_raised, the start is raised by tol.raised_bwh_start_x (step "BwH start raised").
+/// and with in.bwh_start_raised, the start is raised by tol.raised_bwh_start_x (step "BwH start raised"), above
+/// in.neighbour_corner_x when that lies higher than PS and tol.raise_over_neighbour_corner.
 /// Used before servoing; combine() repeats it so its trace is complete.
 CombinationResult validate_p1(const CombinationInputs& in, const CombinationTolerances& tol);
 

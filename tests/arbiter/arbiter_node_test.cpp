@@ -395,11 +395,14 @@ TEST_F(ArbiterNodeTest, ANeighbourCornerFromPsRaisesTheNextBwhStart) {
   EXPECT_TRUE(starts_with(out.got[2].reason, "RAISE_BWH_START: P2 is 25.0 mm left of the stripe end"))
       << out.got[2].reason;
   EXPECT_FALSE(out.got[2].valid);
-  // The next attempt's P1 check: BwH starts from PS 100 mm higher (grasp X 0.10 -> 0.20), same Y and depth.
+  // The next attempt's P1 check: BwH starts 100 mm above that neighbour's corner (grasp X 0.16 -> 0.26; PS.x is
+  // 0.10), same Y and depth.
   send("BOOK_CORNER_STEREO", corner(7000, "god", true, {0.61, -0.325, 0.25}));
   ASSERT_EQ(out.got.size(), 4u);
   EXPECT_TRUE(starts_with(out.got[3].reason, "P1_INVALID")) << out.got[3].reason;
-  expect_vec(out.got[3].gp_grasp, {0.20, 0.255, 0.01}, "BwH start = PS raised, front depth");
+  EXPECT_NE(out.got[3].reason.find("100.0 mm above that corner (160.0 mm above PS)"), std::string::npos)
+      << out.got[3].reason;
+  expect_vec(out.got[3].gp_grasp, {0.26, 0.255, 0.01}, "BwH start = the neighbour's corner raised, front depth");
   // From the raised start BwH centres another neighbour's corner 40 mm left of PS: no grasp, no second raise.
   corner_converged(7500, 3, 0, {0.45, -0.265, 0.30});
   ASSERT_EQ(out.got.size(), 5u);
@@ -410,7 +413,7 @@ TEST_F(ArbiterNodeTest, ANeighbourCornerFromPsRaisesTheNextBwhStart) {
   send("SERVO_STATUS", status(9100, 4, servo_request_t::STRIPE_END, servo_status_t::CONVERGED, {0.45, -0.3052, 0.10}));
   ASSERT_EQ(out.got.size(), 6u);
   EXPECT_TRUE(starts_with(out.got[5].reason, "P1_INVALID")) << out.got[5].reason;
-  expect_vec(out.got[5].gp_grasp, {0.20, 0.2552, 0.01}, "BwH start = the re-measured PS raised");
+  expect_vec(out.got[5].gp_grasp, {0.26, 0.2552, 0.01}, "BwH start = the neighbour's corner raised, re-measured PS");
   // From there BwH centres the tall book's corner (grasp (0.30, 0.253)): grasped.
   corner_converged(10000, 5, 0, {0.45, -0.303, 0.30});
   ASSERT_EQ(out.got.size(), 7u);
@@ -732,7 +735,9 @@ TEST(ArbiterConfig, BadDepthKeysNameTheKey) {
            {"stereo_front.depth_range_m", "depth_range_m: [-0.05, 0.20]", "depth_range_m: [0.20, -0.05]"},
            {"stereo_front.max_tilt_deg", "max_tilt_deg: 20.0", "max_tilt_deg: 95"},
            {"tolerances.raised_bwh_start_m", "raised_bwh_start_m: 0.10", "raised_bwh_start_m: 0.5"},
-           {"tolerances.invalid_p1_over_p2", "invalid_p1_over_p2: true", "invalid_p1_over_p2: 0.2"}}) {
+           {"tolerances.invalid_p1_over_p2", "invalid_p1_over_p2: true", "invalid_p1_over_p2: 0.2"},
+           {"tolerances.raise_over_neighbour_corner", "raise_over_neighbour_corner: true",
+            "raise_over_neighbour_corner: yes please"}}) {
     std::string text = shipped;
     const auto pos = text.find(line);
     ASSERT_NE(pos, std::string::npos) << line;

@@ -427,6 +427,47 @@ TEST(CombinationStrategy, WithoutAValidP1AP2FarLeftOfAMeasuredPsRaisesTheNextBwh
   EXPECT_TRUE(validate_p1(valid, tol).bwh_start.isApprox(V(0.22, 0.099, 0.40), 1e-12));
 }
 
+TEST(CombinationStrategy, TheRaisedBwhStartLiesAboveTheNeighboursCornerBwhFound) {
+  // Far_cart seed 5273: PS at the stripe's height, the 186 mm neighbour's corner BwH found 69 mm above it, the
+  // 290 mm right-most book's corner 173 mm above it. PS + 100 mm left the tall corner out of view.
+  CombinationTolerances tol = kTol;
+  tol.p2_ps_y = 0.010;
+  tol.raised_bwh_start_x = 0.10;
+  CombinationInputs in;
+  in.ps = kPs;  // X 0.00
+  in.ps_measured = true;
+  in.front_z_fallback = 0.42;
+  in.bwh_start_raised = true;
+  in.neighbour_corner_x = 0.069;
+  const CombinationResult r = validate_p1(in, tol);
+  EXPECT_NEAR(r.bwh_start.x(), 0.169, 1e-12);
+  EXPECT_NEAR(r.bwh_start.y(), kPs.y(), 1e-12);
+  EXPECT_NEAR(r.bwh_start.z(), 0.42, 1e-12);
+  ASSERT_FALSE(r.steps.empty());
+  EXPECT_EQ(r.steps.back().rule, "BwH start raised");
+  EXPECT_NEAR(r.steps.back().value, 0.169, 1e-12);
+  EXPECT_NE(r.steps.back().decision.find("100.0 mm above that corner (169.0 mm above PS)"), std::string::npos)
+      << r.steps.back().decision;
+  // The rule off: above PS (stop 28's start).
+  CombinationTolerances off = tol;
+  off.raise_over_neighbour_corner = false;
+  EXPECT_NEAR(validate_p1(in, off).bwh_start.x(), 0.10, 1e-12);
+  // A corner below PS, a non-finite one, or none: above PS.
+  for (const std::optional<double>& x :
+       {std::optional<double>(-0.02), std::optional<double>(NAN), std::optional<double>()}) {
+    CombinationInputs other = in;
+    other.neighbour_corner_x = x;
+    const CombinationResult o = validate_p1(other, tol);
+    EXPECT_NEAR(o.bwh_start.x(), 0.10, 1e-12);
+    ASSERT_FALSE(o.steps.empty());
+    EXPECT_NE(o.steps.back().decision.find("100.0 mm higher"), std::string::npos) << o.steps.back().decision;
+  }
+  // Not raised at this PS: the corner is not used.
+  CombinationInputs not_raised = in;
+  not_raised.bwh_start_raised = false;
+  EXPECT_NEAR(validate_p1(not_raised, tol).bwh_start.x(), 0.0, 1e-12);
+}
+
 TEST(CombinationStrategy, AP2LeftOfAndBelowAnInvalidP1OnItsLeftSendsBwhToThatP1AtAnyPs) {
   // Seed 1's fifth book (deployed demo, stop 30): PS = GP.y - BW after the fourth grasp (not measured). The 0.29 m
   // right-most book leans left: its corner P1 lies 13 mm left of PS (invalid). BwH from PS centred the 0.17 m
