@@ -84,6 +84,7 @@ ArbiterSettings ArbiterSettings::from_config(const Config& root) {
   s.tolerances.raised_bwh_start_x = root.get_double("tolerances.raised_bwh_start_m", 0.0, 0.3);
   s.tolerances.raise_over_neighbour_corner = root.get<bool>("tolerances.raise_over_neighbour_corner");
   s.tolerances.invalid_p1_over_p2 = root.get<bool>("tolerances.invalid_p1_over_p2");
+  s.tolerances.start_from_p1_right_of_measured_ps = root.get<bool>("tolerances.start_from_p1_right_of_measured_ps");
   s.use_stereo_front = root.get<bool>("stereo_front.enabled");
   const std::vector<double> band = root.get_vector("stereo_front.probe_left_of_ps_m", 2);
   if (!(band[0] >= 0 && band[0] < band[1] && band[1] <= 0.1))

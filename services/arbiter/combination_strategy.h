@@ -61,6 +61,13 @@ struct CombinationTolerances {
   /// measured one the p2_ps_y rule answers first). No grasp (kStartFromP1); the next check at this PS takes that P1
   /// as valid (CombinationInputs::p1_between) and BwH starts from it. Such a P2 from there gets kNoGrasp.
   bool invalid_p1_over_p2 = false;
+  /// Not in the paper: a P1 more than p1_ps_y right of a measured PS (CombinationInputs::ps_measured) stays invalid,
+  /// but BwH starts from it, not from PS. The stripe end is the right-most book's right edge, so nothing BwS takes
+  /// for a book front stands right of it unless the stripe servo took its end left of that edge: a shadow on the
+  /// stripe above a short book between two tall ones (far_cart seeds 5117, 5282: PS 55-70 mm left of the right-most
+  /// corner, BwH from PS took a book further left). P2 near P1 is then accepted by p1_p2_agreement_over_ps.
+  /// False = the paper (BwH from PS).
+  bool start_from_p1_right_of_measured_ps = false;
 };
 
 /// One decision of the strategy, with the numbers it was made on.

@@ -385,8 +385,8 @@ TEST_F(ArbiterNodeTest, AP1ThatLedBwhToTheNeighbourIsNotUsedAgainAtThatPs) {
 // neighbour's corner 25 mm left of the measured PS. No grasp; the next P1 check at the same PS starts BwH higher
 // (tolerances.raised_bwh_start_m), from where the tall book's own corner is grasped.
 TEST_F(ArbiterNodeTest, ANeighbourCornerFromPsRaisesTheNextBwhStart) {
-  // P1 base y -0.325 -> grasp 0.275, 20 mm from PS.y 0.255: invalid, BwH from PS.
-  first_run({0.61, -0.325, 0.25}, {0.45, -0.305, 0.10});
+  // P1 base y -0.285 -> grasp 0.235, 20 mm left of PS.y 0.255 (on the shorter neighbour): invalid, BwH from PS.
+  first_run({0.61, -0.285, 0.25}, {0.45, -0.305, 0.10});
   ASSERT_EQ(out.got.size(), 2u);
   EXPECT_TRUE(starts_with(out.got[1].reason, "P1_INVALID")) << out.got[1].reason;
   // P2 grasp (0.16, 0.230): 25 mm left of the measured PS.
@@ -397,7 +397,7 @@ TEST_F(ArbiterNodeTest, ANeighbourCornerFromPsRaisesTheNextBwhStart) {
   EXPECT_FALSE(out.got[2].valid);
   // The next attempt's P1 check: BwH starts 100 mm above that neighbour's corner (grasp X 0.16 -> 0.26; PS.x is
   // 0.10), same Y and depth.
-  send("BOOK_CORNER_STEREO", corner(7000, "god", true, {0.61, -0.325, 0.25}));
+  send("BOOK_CORNER_STEREO", corner(7000, "god", true, {0.61, -0.285, 0.25}));
   ASSERT_EQ(out.got.size(), 4u);
   EXPECT_TRUE(starts_with(out.got[3].reason, "P1_INVALID")) << out.got[3].reason;
   EXPECT_NE(out.got[3].reason.find("100.0 mm above that corner (160.0 mm above PS)"), std::string::npos)
@@ -419,6 +419,24 @@ TEST_F(ArbiterNodeTest, ANeighbourCornerFromPsRaisesTheNextBwhStart) {
   ASSERT_EQ(out.got.size(), 7u);
   EXPECT_TRUE(starts_with(out.got[6].reason, "GRASP")) << out.got[6].reason;
   expect_vec(out.got[6].gp_grasp, {0.30, 0.253, 0.01}, "GP at the tall book's corner");
+}
+
+// The stripe servo took its end at a shadow left of the right-most book: BwS's P1 lies 59 mm right of the measured
+// PS. P1 stays invalid, but BwH starts from it (tolerances.start_from_p1_right_of_measured_ps) and the corner it
+// centres next to P1 is grasped.
+TEST_F(ArbiterNodeTest, AP1RightOfTheMeasuredStripeEndStartsBwhFromP1) {
+  // P1 base y -0.364 -> grasp 0.314, 59 mm right of PS.y 0.255.
+  first_run({0.61, -0.364, 0.25}, {0.45, -0.305, 0.10});
+  ASSERT_EQ(out.got.size(), 2u);
+  EXPECT_TRUE(starts_with(out.got[1].reason, "P1_INVALID: P1 invalid (59.0 mm right of the measured stripe end"))
+      << out.got[1].reason;
+  EXPECT_FALSE(out.got[1].p1_used);
+  expect_vec(out.got[1].gp_grasp, {0.25, 0.314, 0.01}, "BwH start = P1, front depth");
+  // P2 grasp (0.26, 0.324): 10 mm right of P1, 69 mm right of PS: both sensors agree, grasped.
+  corner_converged(5000, 2, 0, {0.45, -0.374, 0.26});
+  ASSERT_EQ(out.got.size(), 3u);
+  EXPECT_TRUE(starts_with(out.got[2].reason, "GRASP")) << out.got[2].reason;
+  expect_vec(out.got[2].gp_grasp, {0.26, 0.324, 0.01}, "GP at the corner BwH found from P1");
 }
 
 // After a grasp, PS is the estimate GP.y - BW. The next right-most book is tall and leans left: its P1 fails the PS
@@ -461,12 +479,12 @@ TEST_F(ArbiterNodeTest, NoRegionLeftGivesNoGrasp) {
 }
 
 TEST_F(ArbiterNodeTest, InvalidP1StartsBwhFromPsAndTakesZFromCartModel) {
-  // P1 base y -0.325 -> grasp y 0.275, 20 mm from PS.y 0.255 -> invalid; BwH starts from PS.
-  first_run({0.61, -0.325, 0.25}, {0.45, -0.305, 0.10});
+  // P1 base y -0.285 -> grasp y 0.235, 20 mm left of PS.y 0.255 -> invalid; BwH starts from PS.
+  first_run({0.61, -0.285, 0.25}, {0.45, -0.305, 0.10});
   ASSERT_EQ(out.got.size(), 2u);
   EXPECT_TRUE(starts_with(out.got[1].reason, "P1_INVALID")) << out.got[1].reason;
   EXPECT_FALSE(out.got[1].p1_used);
-  // BwH starts from PS in X and Y; Z is the front depth the corner servo assumes: P1 grasp (0.25, 0.275, 0.01)
+  // BwH starts from PS in X and Y; Z is the front depth the corner servo assumes: P1 grasp (0.25, 0.235, 0.01)
   // is invalid in Y but its Z lies within invalid_p1_depth_range_m of book_front_z_m 0.01 -> 0.01.
   expect_vec(out.got[1].gp_grasp, {0.10, 0.255, 0.01}, "BwH start = PS, front depth");
   // P2 grasp (0.24, 0.26, -0.15): 5 mm right of PS -> valid; no P1 -> X as is, Z = book_front_z_m 0.01.
@@ -504,11 +522,11 @@ TEST_F(ArbiterNodeTest, AStereoFrontLeftOfPsGivesTheDepthWhenP1IsInvalid) {
   const plane_region_t good = pushed_front_region();
   plane_region_t bad = good;
   bad.extent_min_base[0] = NAN;  // one bad field: not a plane to measure (its finite corners alone gave 0.08)
-  // P1 2 cm right of PS: invalid; its own Z 0.01 is the depth without a usable region.
+  // P1 2 cm left of PS: invalid; its own Z 0.01 is the depth without a usable region.
   for (const auto& [region, front_z] : {std::pair{good, 0.08}, std::pair{bad, 0.01}}) {
     SCOPED_TRACE("front " + std::to_string(front_z));
     out.got.clear();
-    book_corner_stereo_t c = corner(2000, "god", true, {0.61, -0.325, 0.25});
+    book_corner_stereo_t c = corner(2000, "god", true, {0.61, -0.285, 0.25});
     c.regions = {region};
     c.num_regions = 1;
     send("SERVO_REQUEST", request(1500, 0, servo_request_t::CANCEL));  // a fresh attempt for each case
@@ -737,7 +755,9 @@ TEST(ArbiterConfig, BadDepthKeysNameTheKey) {
            {"tolerances.raised_bwh_start_m", "raised_bwh_start_m: 0.10", "raised_bwh_start_m: 0.5"},
            {"tolerances.invalid_p1_over_p2", "invalid_p1_over_p2: true", "invalid_p1_over_p2: 0.2"},
            {"tolerances.raise_over_neighbour_corner", "raise_over_neighbour_corner: true",
-            "raise_over_neighbour_corner: yes please"}}) {
+            "raise_over_neighbour_corner: yes please"},
+           {"tolerances.start_from_p1_right_of_measured_ps", "start_from_p1_right_of_measured_ps: true",
+            "start_from_p1_right_of_measured_ps: 3"}}) {
     std::string text = shipped;
     const auto pos = text.find(line);
     ASSERT_NE(pos, std::string::npos) << line;

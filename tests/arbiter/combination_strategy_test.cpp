@@ -468,6 +468,57 @@ TEST(CombinationStrategy, TheRaisedBwhStartLiesAboveTheNeighboursCornerBwhFound)
   EXPECT_NEAR(validate_p1(not_raised, tol).bwh_start.x(), 0.0, 1e-12);
 }
 
+TEST(CombinationStrategy, AnInvalidP1RightOfAMeasuredPsStartsBwhFromP1) {
+  // Far_cart seed 5282: the stripe end taken at a shadow above a short book, 69.7 mm left of the right-most corner;
+  // P1 on the right-most book, 59 mm right of PS. The paper starts BwH from PS, which took a book further left.
+  CombinationTolerances tol = kTol;
+  tol.start_from_p1_right_of_measured_ps = true;
+  CombinationInputs in;
+  in.ps = kPs;  // (0.00, 0.100, 0.50)
+  in.ps_measured = true;
+  in.front_z_fallback = 0.42;
+  in.p1 = V(0.257, 0.159, 0.41);
+  const CombinationResult check = validate_p1(in, tol);
+  EXPECT_FALSE(check.p1_valid);
+  EXPECT_TRUE(check.bwh_start.isApprox(V(0.257, 0.159, 0.42), 1e-12)) << check.bwh_start.transpose();
+  ASSERT_FALSE(check.steps.empty());
+  EXPECT_EQ(check.steps.back().rule, "P1 right of the measured PS");
+  EXPECT_NEAR(check.steps.back().value, 0.059, 1e-12);
+  EXPECT_NE(check.steps.back().decision.find("59.0 mm right of the measured stripe end"), std::string::npos)
+      << check.steps.back().decision;
+  // BwH from P1 centres the right-most corner 11 mm right of P1: both sensors agree, grasped there (P1 stays
+  // invalid: GP.z from the model's front plane).
+  in.p2 = V(0.258, 0.170, 0.45);
+  const CombinationResult r = combine(in, tol);
+  EXPECT_EQ(r.outcome, GraspOutcome::kGrasp);
+  EXPECT_TRUE(r.gp.isApprox(V(0.258, 0.170, 0.42), 1e-12)) << r.gp.transpose();
+  // A raised start at this PS does not move a start from P1.
+  CombinationInputs raised = in;
+  raised.bwh_start_raised = true;
+  raised.neighbour_corner_x = 0.14;
+  CombinationTolerances raise_tol = tol;
+  raise_tol.p2_ps_y = 0.010;
+  raise_tol.raised_bwh_start_x = 0.10;
+  EXPECT_TRUE(validate_p1(raised, raise_tol).bwh_start.isApprox(V(0.257, 0.159, 0.42), 1e-12));
+  // From PS: the rule off, PS the estimate GP.y - BW, or P1 left of PS (the paper's missed thin book).
+  CombinationTolerances off = tol;
+  off.start_from_p1_right_of_measured_ps = false;
+  EXPECT_TRUE(validate_p1(in, off).bwh_start.isApprox(V(0.0, 0.100, 0.42), 1e-12));
+  CombinationInputs estimated = in;
+  estimated.ps_measured = false;
+  EXPECT_TRUE(validate_p1(estimated, tol).bwh_start.isApprox(V(0.0, 0.100, 0.42), 1e-12));
+  CombinationInputs left = in;
+  left.p1 = V(0.257, 0.041, 0.41);
+  const CombinationResult from_ps = validate_p1(left, tol);
+  EXPECT_TRUE(from_ps.bwh_start.isApprox(V(0.0, 0.100, 0.42), 1e-12));
+  ASSERT_FALSE(from_ps.steps.empty());
+  EXPECT_EQ(from_ps.steps.back().rule, "P1.y vs PS.y");
+  // Within p1_ps_y it is the paper's valid P1.
+  CombinationInputs near = in;
+  near.p1 = V(0.257, 0.108, 0.41);
+  EXPECT_TRUE(validate_p1(near, tol).p1_valid);
+}
+
 TEST(CombinationStrategy, AP2LeftOfAndBelowAnInvalidP1OnItsLeftSendsBwhToThatP1AtAnyPs) {
   // Seed 1's fifth book (deployed demo, stop 30): PS = GP.y - BW after the fourth grasp (not measured). The 0.29 m
   // right-most book leans left: its corner P1 lies 13 mm left of PS (invalid). BwH from PS centred the 0.17 m
