@@ -411,6 +411,7 @@ void ArbiterNode::decide(const servo_status_t& msg) {
       break;
     case GraspOutcome::kNoGrasp:
       m.reason = "NO_GRASP: " + last;
+      if (!in.p2 && bwh_started_from_p1_right_of_ps(r)) p1_right_failed_at_ps_ = ps_;
       open_attempt();
       break;
   }
@@ -429,6 +430,7 @@ CombinationInputs ArbiterNode::common_inputs() const {
   in.bwh_start_raised = same_stripe_end(raised_at_ps_, *ps_);
   if (in.bwh_start_raised && raised_over_corner_) in.neighbour_corner_x = to_grasp(*raised_over_corner_).x();
   in.p1_between = same_stripe_end(p1_between_at_ps_, *ps_);
+  in.p1_right_start_failed = same_stripe_end(p1_right_failed_at_ps_, *ps_);
   if (corner_at_ps_ && corner_at_ps_->ps == *ps_) in.earlier_corner_z = corner_at_ps_->z;
   in.front_z_fallback = s_.book_front_z;
   in.stereo_front_z = stereo_front_z(in.ps);

@@ -144,6 +144,9 @@ class ArbiterNode : public Component {
   /// The PS (base) at which BwH from PS found a corner left of and below a P1 on PS's left (GraspOutcome::
   /// kStartFromP1): at the same PS (within 3 mm), such a P1 is used.
   std::optional<Eigen::Vector3d> p1_between_at_ps_;
+  /// The PS (base) at which BwH started from a P1 right of it and did not converge: at the same PS (within 3 mm),
+  /// BwH starts from PS (CombinationInputs::p1_right_start_failed).
+  std::optional<Eigen::Vector3d> p1_right_failed_at_ps_;
   /// R's depth (grasp Z) the corner servo triangulated for the last GRASP, and the PS (base) it was decided at:
   /// CombinationInputs::earlier_corner_z while PS stays that one (a failed attempt at the same book).
   struct CornerAtPs {

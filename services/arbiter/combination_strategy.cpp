@@ -108,12 +108,17 @@ CombinationResult validate_p1_against_ps(const CombinationInputs& in, const Comb
     r.p1_valid = true;
     r.bwh_start = *in.p1;
     r.steps.push_back(step("P1.y vs PS.y", d, tol.p1_ps_y, true, "P1 valid: BwH starts from P1"));
-  } else if (tol.start_from_p1_right_of_measured_ps && in.ps_measured && d > tol.p1_ps_y) {
+  } else if (tol.start_from_p1_right_of_measured_ps && in.ps_measured && d > tol.p1_ps_y && !in.p1_right_start_failed) {
     r.bwh_start.head<2>() = in.p1->head<2>();
     r.steps.push_back(step(kP1RightOfMeasuredPs, d, tol.p1_ps_y, false,
                            "P1 invalid (" + mm(d) +
                                " right of the measured stripe end, where no book should stand: the stripe end was "
                                "taken left of the right-most book's edge): BwH starts from P1"));
+  } else if (tol.start_from_p1_right_of_measured_ps && in.ps_measured && d > tol.p1_ps_y) {
+    r.steps.push_back(step("P1 right of the measured PS, BwH from it failed", d, tol.p1_ps_y, false,
+                           "P1 invalid (" + mm(d) +
+                               " right of the measured stripe end), and BwH from it found no corner at this PS "
+                               "before (e.g. a book leaning on the side panel): BwH starts from PS"));
   } else {
     r.steps.push_back(step("P1.y vs PS.y", d, tol.p1_ps_y, false,
                            "P1 invalid (" + mm(d) + " from PS, e.g. a thin book BwS missed): ignore BwS, BwH "
@@ -127,7 +132,7 @@ CombinationResult validate_p1_against_ps(const CombinationInputs& in, const Comb
 CombinationResult validate_p1(const CombinationInputs& in, const CombinationTolerances& tol) {
   CombinationResult r = validate_p1_against_ps(in, tol);
   if (r.p1_valid || !in.bwh_start_raised || !(tol.raised_bwh_start_x > 0) || !r.bwh_start.allFinite()) return r;
-  if (!r.steps.empty() && r.steps.back().rule == kP1RightOfMeasuredPs) return r;  // BwH does not start from PS
+  if (bwh_started_from_p1_right_of_ps(r)) return r;  // BwH does not start from PS
   const double ps_x = r.bwh_start.x();
   const bool over_corner = tol.raise_over_neighbour_corner && in.neighbour_corner_x &&
                            std::isfinite(*in.neighbour_corner_x) && *in.neighbour_corner_x > ps_x;
@@ -138,6 +143,12 @@ CombinationResult validate_p1(const CombinationInputs& in, const CombinationTole
                          "BwH from PS found a shorter left neighbour's corner at this PS before: it starts " +
                              mm(tol.raised_bwh_start_x) + above + ", where a tall right-most book's corner lies"));
   return r;
+}
+
+bool bwh_started_from_p1_right_of_ps(const CombinationResult& r) {
+  for (const ValidationStep& st : r.steps)
+    if (st.rule == kP1RightOfMeasuredPs) return true;
+  return false;
 }
 
 CombinationResult combine(const CombinationInputs& in, const CombinationTolerances& tol) {

@@ -66,6 +66,8 @@ struct CombinationTolerances {
   /// for a book front stands right of it unless the stripe servo took its end left of that edge: a shadow on the
   /// stripe above a short book between two tall ones (far_cart seeds 5117, 5282: PS 55-70 mm left of the right-most
   /// corner, BwH from PS took a book further left). P2 near P1 is then accepted by p1_p2_agreement_over_ps.
+  /// Once BwH from such a P1 found no corner at this PS (CombinationInputs::p1_right_start_failed: far_cart seeds
+  /// 5445, 5456: the right-most book leaning on the right side panel), BwH starts from PS again.
   /// False = the paper (BwH from PS).
   bool start_from_p1_right_of_measured_ps = false;
 };
@@ -134,6 +136,9 @@ struct CombinationInputs {
   /// At this PS, BwH from PS found a corner left of and below a P1 that failed the PS check on its left before
   /// (CombinationTolerances::invalid_p1_over_p2): such a P1 is taken as valid, its book standing between.
   bool p1_between = false;
+  /// At this PS, BwH started from a P1 right of it (CombinationTolerances::start_from_p1_right_of_measured_ps) and
+  /// did not converge: BwH starts from PS.
+  bool p1_right_start_failed = false;
 };
 
 /// Result: GP (grasp frame) and every step.
@@ -168,6 +173,10 @@ CombinationResult validate_p1(const CombinationInputs& in, const CombinationTole
 /// (tol.use_hand_corner), P2.x and GP.z come from it.
 /// Inputs with NaN give kNoGrasp with a step naming the bad input.
 CombinationResult combine(const CombinationInputs& in, const CombinationTolerances& tol);
+
+/// Whether `r` started BwH from an invalid P1 right of a measured PS (step "P1 right of the measured PS",
+/// CombinationTolerances::start_from_p1_right_of_measured_ps).
+bool bwh_started_from_p1_right_of_ps(const CombinationResult& r);
 
 /// The next PS after a successful grasp (Section 3): PS.y = GP.y - BW, where
 /// BW is the book width measured by the gripper plates; x and z kept from PS.

@@ -439,6 +439,28 @@ TEST_F(ArbiterNodeTest, AP1RightOfTheMeasuredStripeEndStartsBwhFromP1) {
   expect_vec(out.got[2].gp_grasp, {0.26, 0.324, 0.01}, "GP at the corner BwH found from P1");
 }
 
+// The right-most book leans on the side panel (far_cart seeds 5445, 5456): BwH from the P1 right of the measured PS
+// finds no fore-edge. The next P1 checks at that PS start BwH from PS again (the paper).
+TEST_F(ArbiterNodeTest, BwhFromAP1RightOfPsThatFoundNoCornerFallsBackToPs) {
+  first_run({0.61, -0.364, 0.25}, {0.45, -0.305, 0.10});
+  ASSERT_EQ(out.got.size(), 2u);
+  expect_vec(out.got[1].gp_grasp, {0.25, 0.314, 0.01}, "BwH start = P1");
+  send("SERVO_REQUEST", request(5000, 2, servo_request_t::BOOK_CORNER, 0));
+  send("SERVO_STATUS", status(6000, 2, servo_request_t::BOOK_CORNER, servo_status_t::FEATURE_LOST, {0, 0, 0}));
+  ASSERT_EQ(out.got.size(), 3u);
+  EXPECT_TRUE(starts_with(out.got[2].reason, "NO_GRASP: no P2")) << out.got[2].reason;
+  send("BOOK_CORNER_STEREO", corner(7000, "god", true, {0.61, -0.364, 0.25}));
+  ASSERT_EQ(out.got.size(), 4u);
+  EXPECT_NE(out.got[3].reason.find("BwH from it found no corner at this PS before"), std::string::npos)
+      << out.got[3].reason;
+  expect_vec(out.got[3].gp_grasp, {0.10, 0.255, 0.01}, "BwH start = PS");
+  // The stripe end measured again 0.2 mm away is the same: still from PS.
+  send("SERVO_REQUEST", request(8000, 3, servo_request_t::STRIPE_END));
+  send("SERVO_STATUS", status(8100, 3, servo_request_t::STRIPE_END, servo_status_t::CONVERGED, {0.45, -0.3052, 0.10}));
+  ASSERT_EQ(out.got.size(), 5u);
+  expect_vec(out.got[4].gp_grasp, {0.10, 0.2552, 0.01}, "BwH start = the re-measured PS");
+}
+
 // After a grasp, PS is the estimate GP.y - BW. The next right-most book is tall and leans left: its P1 fails the PS
 // check on the left; BwH from PS centres a shorter neighbour's corner left of and below P1. No grasp; the next P1
 // check takes that P1 as valid (tolerances.invalid_p1_over_p2), and from it the tall book is grasped.

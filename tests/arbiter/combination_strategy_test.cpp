@@ -492,6 +492,16 @@ TEST(CombinationStrategy, AnInvalidP1RightOfAMeasuredPsStartsBwhFromP1) {
   const CombinationResult r = combine(in, tol);
   EXPECT_EQ(r.outcome, GraspOutcome::kGrasp);
   EXPECT_TRUE(r.gp.isApprox(V(0.258, 0.170, 0.42), 1e-12)) << r.gp.transpose();
+  EXPECT_TRUE(bwh_started_from_p1_right_of_ps(r));
+  // BwH from P1 found no corner at this PS before (a book leaning on the side panel): from PS, the paper's start.
+  CombinationInputs failed = in;
+  failed.p1_right_start_failed = true;
+  const CombinationResult back = validate_p1(failed, tol);
+  EXPECT_FALSE(back.p1_valid);
+  EXPECT_TRUE(back.bwh_start.isApprox(V(0.0, 0.100, 0.42), 1e-12)) << back.bwh_start.transpose();
+  ASSERT_FALSE(back.steps.empty());
+  EXPECT_EQ(back.steps.back().rule, "P1 right of the measured PS, BwH from it failed");
+  EXPECT_FALSE(bwh_started_from_p1_right_of_ps(back));
   // A raised start at this PS does not move a start from P1.
   CombinationInputs raised = in;
   raised.bwh_start_raised = true;
