@@ -207,8 +207,15 @@ CombinationResult combine(const CombinationInputs& in, const CombinationToleranc
   // left neighbour's corner. With a valid P1 it is the book P1 lay on, a taller neighbour of a thin right-most book
   // (P1_LED_ASTRAY: BwH from PS next). Without one, BwH from PS at the stripe's height centred a shorter neighbour's
   // corner, the tall right-most book's lying above the view (RAISE_BWH_START: BwH from higher next; once raised, no
-  // grasp). After the rule above: a P2 left of and above a P1 on the right book keeps GP = P1.
-  if (in.ps_measured && tol.p2_ps_y > 0 && (r.p1_valid || tol.raised_bwh_start_x > 0)) {
+  // grasp). After the rule above: a P2 left of and above a P1 on the right book keeps GP = P1. Not when BwH started
+  // from an invalid P1 right of the measured PS: that PS is taken as off (far_cart seed 5498: the stripe end 202 mm
+  // left of a book leaning on the side panel; raising from there sent BwH above every book).
+  const bool from_p1_right = bwh_started_from_p1_right_of_ps(r);
+  if (in.ps_measured && tol.p2_ps_y > 0 && (r.p1_valid || tol.raised_bwh_start_x > 0) && from_p1_right &&
+      p2.y() - in.ps.y() < -tol.p2_ps_y) {
+    r.steps.push_back(step("P2.y vs measured PS.y", p2.y() - in.ps.y(), tol.p2_ps_y, true,
+                           "not checked: BwH started from P1 right of the measured PS, which is taken as off"));
+  } else if (in.ps_measured && tol.p2_ps_y > 0 && (r.p1_valid || tol.raised_bwh_start_x > 0)) {
     const double dps = p2.y() - in.ps.y();
     if (dps < -tol.p2_ps_y) {
       std::string why;

@@ -493,6 +493,22 @@ TEST(CombinationStrategy, AnInvalidP1RightOfAMeasuredPsStartsBwhFromP1) {
   EXPECT_EQ(r.outcome, GraspOutcome::kGrasp);
   EXPECT_TRUE(r.gp.isApprox(V(0.258, 0.170, 0.42), 1e-12)) << r.gp.transpose();
   EXPECT_TRUE(bwh_started_from_p1_right_of_ps(r));
+  // From P1, BwH centred a corner 25 mm left of PS (seed 5498, a book leaning on the side panel): PS is taken as off,
+  // so no raise (which assumes BwH started from PS); the paper's Y rule accepts it.
+  CombinationTolerances raising = tol;
+  raising.p2_ps_y = 0.010;
+  raising.raised_bwh_start_x = 0.10;
+  CombinationInputs left_of_ps = in;
+  left_of_ps.p2 = V(0.12, 0.075, 0.45);
+  const CombinationResult unchecked = combine(left_of_ps, raising);
+  EXPECT_EQ(unchecked.outcome, GraspOutcome::kGrasp);
+  bool skipped = false;
+  for (const ValidationStep& st : unchecked.steps)
+    skipped |= st.rule == "P2.y vs measured PS.y" && st.decision.find("not checked") != std::string::npos;
+  EXPECT_TRUE(skipped);
+  CombinationInputs from_ps_start = left_of_ps;
+  from_ps_start.p1_right_start_failed = true;  // BwH from PS: the raise applies
+  EXPECT_EQ(combine(from_ps_start, raising).outcome, GraspOutcome::kRaiseBwhStart);
   // BwH from P1 found no corner at this PS before (a book leaning on the side panel): from PS, the paper's start.
   CombinationInputs failed = in;
   failed.p1_right_start_failed = true;
