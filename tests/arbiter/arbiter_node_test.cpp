@@ -142,6 +142,16 @@ class ArbiterNodeTest : public testing::Test {
     send("SERVO_REQUEST", request(3000, 1, servo_request_t::STRIPE_END));
     send("SERVO_STATUS", status(4000, 1, servo_request_t::STRIPE_END, servo_status_t::CONVERGED, ps_base));
   }
+  /// The first run with P1 59 mm right of the measured PS (P1 base y -0.364 -> grasp 0.314, PS.y 0.255): P1 stays
+  /// invalid and BwH starts from it, the second message.
+  void first_run_p1_right_of_ps() {
+    first_run({0.61, -0.364, 0.25}, {0.45, -0.305, 0.10});
+    ASSERT_EQ(out.got.size(), 2u);
+    EXPECT_TRUE(starts_with(out.got[1].reason, "P1_INVALID: P1 invalid (59.0 mm right of the measured stripe end"))
+        << out.got[1].reason;
+    EXPECT_FALSE(out.got[1].p1_used);
+    expect_vec(out.got[1].gp_grasp, {0.25, 0.314, 0.01}, "BwH start = P1, front depth");
+  }
   /// A BOOK_CORNER servo request `id` of BwH rank `rank` at `t`, converged 1 ms later with the TCP at `tcp_base`.
   void corner_converged(int64_t t, int64_t id, int rank, const Eigen::Vector3d& tcp_base) {
     send("SERVO_REQUEST", request(t, id, servo_request_t::BOOK_CORNER, rank));
@@ -425,13 +435,7 @@ TEST_F(ArbiterNodeTest, ANeighbourCornerFromPsRaisesTheNextBwhStart) {
 // PS. P1 stays invalid, but BwH starts from it (tolerances.start_from_p1_right_of_measured_ps) and the corner it
 // centres next to P1 is grasped.
 TEST_F(ArbiterNodeTest, AP1RightOfTheMeasuredStripeEndStartsBwhFromP1) {
-  // P1 base y -0.364 -> grasp 0.314, 59 mm right of PS.y 0.255.
-  first_run({0.61, -0.364, 0.25}, {0.45, -0.305, 0.10});
-  ASSERT_EQ(out.got.size(), 2u);
-  EXPECT_TRUE(starts_with(out.got[1].reason, "P1_INVALID: P1 invalid (59.0 mm right of the measured stripe end"))
-      << out.got[1].reason;
-  EXPECT_FALSE(out.got[1].p1_used);
-  expect_vec(out.got[1].gp_grasp, {0.25, 0.314, 0.01}, "BwH start = P1, front depth");
+  first_run_p1_right_of_ps();
   // P2 grasp (0.26, 0.324): 10 mm right of P1, 69 mm right of PS: both sensors agree, grasped.
   corner_converged(5000, 2, 0, {0.45, -0.374, 0.26});
   ASSERT_EQ(out.got.size(), 3u);
@@ -442,9 +446,7 @@ TEST_F(ArbiterNodeTest, AP1RightOfTheMeasuredStripeEndStartsBwhFromP1) {
 // The right-most book leans on the side panel (far_cart seeds 5445, 5456): BwH from the P1 right of the measured PS
 // finds no fore-edge. The next P1 checks at that PS start BwH from PS again (the paper).
 TEST_F(ArbiterNodeTest, BwhFromAP1RightOfPsThatFoundNoCornerFallsBackToPs) {
-  first_run({0.61, -0.364, 0.25}, {0.45, -0.305, 0.10});
-  ASSERT_EQ(out.got.size(), 2u);
-  expect_vec(out.got[1].gp_grasp, {0.25, 0.314, 0.01}, "BwH start = P1");
+  first_run_p1_right_of_ps();
   send("SERVO_REQUEST", request(5000, 2, servo_request_t::BOOK_CORNER, 0));
   send("SERVO_STATUS", status(6000, 2, servo_request_t::BOOK_CORNER, servo_status_t::FEATURE_LOST, {0, 0, 0}));
   ASSERT_EQ(out.got.size(), 3u);
