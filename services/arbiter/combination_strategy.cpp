@@ -210,14 +210,12 @@ CombinationResult combine(const CombinationInputs& in, const CombinationToleranc
   // grasp). After the rule above: a P2 left of and above a P1 on the right book keeps GP = P1. Not when BwH started
   // from an invalid P1 right of the measured PS: that PS is taken as off (far_cart seed 5498: the stripe end 202 mm
   // left of a book leaning on the side panel; raising from there sent BwH above every book).
-  const bool from_p1_right = bwh_started_from_p1_right_of_ps(r);
-  if (in.ps_measured && tol.p2_ps_y > 0 && (r.p1_valid || tol.raised_bwh_start_x > 0) && from_p1_right &&
-      p2.y() - in.ps.y() < -tol.p2_ps_y) {
-    r.steps.push_back(step("P2.y vs measured PS.y", p2.y() - in.ps.y(), tol.p2_ps_y, true,
-                           "not checked: BwH started from P1 right of the measured PS, which is taken as off"));
-  } else if (in.ps_measured && tol.p2_ps_y > 0 && (r.p1_valid || tol.raised_bwh_start_x > 0)) {
+  if (in.ps_measured && tol.p2_ps_y > 0 && (r.p1_valid || tol.raised_bwh_start_x > 0)) {
     const double dps = p2.y() - in.ps.y();
-    if (dps < -tol.p2_ps_y) {
+    if (dps < -tol.p2_ps_y && bwh_started_from_p1_right_of_ps(r)) {
+      r.steps.push_back(step("P2.y vs measured PS.y", dps, tol.p2_ps_y, true,
+                             "not checked: BwH started from P1 right of the measured PS, which is taken as off"));
+    } else if (dps < -tol.p2_ps_y) {
       std::string why;
       if (r.p1_valid) {
         r.outcome = GraspOutcome::kP1LedAstray;
@@ -236,8 +234,9 @@ CombinationResult combine(const CombinationInputs& in, const CombinationToleranc
       }
       r.steps.push_back(step("P2.y vs measured PS.y", dps, tol.p2_ps_y, false, why));
       return r;
+    } else {
+      r.steps.push_back(step("P2.y vs measured PS.y", dps, tol.p2_ps_y, true, "P2 at the stripe end's book"));
     }
-    r.steps.push_back(step("P2.y vs measured PS.y", dps, tol.p2_ps_y, true, "P2 at the stripe end's book"));
   }
   // Not in the paper: an invalid P1 left of PS with P2 left of and below it: P1's (taller) book stands between P2's
   // and PS, so P2 is not the right-most book's corner (deployed demo, seed 1's fifth book: P1 on the 0.29 m right-most
