@@ -108,17 +108,19 @@ CombinationResult validate_p1_against_ps(const CombinationInputs& in, const Comb
     r.p1_valid = true;
     r.bwh_start = *in.p1;
     r.steps.push_back(step("P1.y vs PS.y", d, tol.p1_ps_y, true, "P1 valid: BwH starts from P1"));
-  } else if (tol.start_from_p1_right_of_measured_ps && in.ps_measured && d > tol.p1_ps_y && !in.p1_right_start_failed) {
-    r.bwh_start.head<2>() = in.p1->head<2>();
-    r.steps.push_back(step(kP1RightOfMeasuredPs, d, tol.p1_ps_y, false,
-                           "P1 invalid (" + mm(d) +
-                               " right of the measured stripe end, where no book should stand: the stripe end was "
-                               "taken left of the right-most book's edge): BwH starts from P1"));
   } else if (tol.start_from_p1_right_of_measured_ps && in.ps_measured && d > tol.p1_ps_y) {
-    r.steps.push_back(step("P1 right of the measured PS, BwH from it failed", d, tol.p1_ps_y, false,
-                           "P1 invalid (" + mm(d) +
-                               " right of the measured stripe end), and BwH from it found no corner at this PS "
-                               "before (e.g. a book leaning on the side panel): BwH starts from PS"));
+    if (in.p1_right_start_failed) {
+      r.steps.push_back(step("P1 right of the measured PS, BwH from it failed", d, tol.p1_ps_y, false,
+                             "P1 invalid (" + mm(d) +
+                                 " right of the measured stripe end), and BwH from it found no corner at this PS "
+                                 "before (e.g. a book leaning on the side panel): BwH starts from PS"));
+    } else {
+      r.bwh_start.head<2>() = in.p1->head<2>();
+      r.steps.push_back(step(kP1RightOfMeasuredPs, d, tol.p1_ps_y, false,
+                             "P1 invalid (" + mm(d) +
+                                 " right of the measured stripe end, where no book should stand: the stripe end was "
+                                 "taken left of the right-most book's edge): BwH starts from P1"));
+    }
   } else {
     r.steps.push_back(step("P1.y vs PS.y", d, tol.p1_ps_y, false,
                            "P1 invalid (" + mm(d) + " from PS, e.g. a thin book BwS missed): ignore BwS, BwH "
