@@ -2,13 +2,15 @@
 /// bookgrasp_eval_bws: BwS accuracy and timing over seeded random simulated scenes.
 ///
 ///   bookgrasp_eval_bws --scenes N --seed S [--scene FILE] [--impl god|pcl] [--config FILE]
-///                      [--overlays K] [--marker-config FILE] --out DIR
+///                      [--overlays K] [--marker-config FILE] [--first-utime U] --out DIR
 ///
 /// Scenes S..S+N-1 of FILE (default config/scenes/default.yaml) are rendered by the simulator; the
 /// cart marker is found by the marker detector (config/services/marker_detector.yaml) and the
 /// bws_detector component (config/services/bws_detector.yaml, or bws_detector_pcl.yaml for --impl pcl)
 /// answers the stereo frame. Writes DIR/metrics.json, DIR/report.md, DIR/figure12.png and overlay PNGs
-/// (overlay_<seed>.png) of the first K scenes (default 5) and of every failed scene.
+/// (overlay_<seed>.png) of the first K scenes (default 5) and of every failed scene. The frame is stamped U
+/// (default 1000000); the simulated camera's pixel noise is seeded by it, so another U gives the same scenes
+/// with other noise (how much P1 moves from frame to frame: docs/BWS.md, stop 40).
 
 #include <cstdlib>
 #include <filesystem>
@@ -30,10 +32,13 @@ namespace {
 
 int usage(const std::string& why) {
   if (!why.empty()) std::cerr << "bookgrasp_eval_bws: " << why << "\n";
-  std::cerr << "usage: bookgrasp_eval_bws --scenes N --seed S [--scene FILE] [--impl god|pcl] [--config FILE]\n"
-               "                          [--overlays K] [--marker-config FILE] [--verbose] --out DIR\n"
-               "  renders scenes S..S+N-1, runs the marker detector and the bws_detector on each stereo pair,\n"
-               "  writes DIR/metrics.json, DIR/report.md, DIR/figure12.png, overlay_<seed>.png\n";
+  std::cerr
+      << "usage: bookgrasp_eval_bws --scenes N --seed S [--scene FILE] [--impl god|pcl] [--config FILE]\n"
+         "                          [--overlays K] [--marker-config FILE] [--first-utime U] [--verbose] --out DIR\n"
+         "  renders scenes S..S+N-1, runs the marker detector and the bws_detector on each stereo pair,\n"
+         "  writes DIR/metrics.json, DIR/report.md, DIR/figure12.png, overlay_<seed>.png\n"
+         "  --first-utime U stamps each frame U (default 1000000): the pixel noise is seeded by it, so another\n"
+         "  U gives the same scenes with other noise\n";
   return why.empty() ? 0 : 2;
 }
 
@@ -44,7 +49,7 @@ std::string in_source(const std::string& p) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  long long scenes = -1, seed = -1, overlays = 5;
+  long long scenes = -1, seed = -1, overlays = 5, first_utime = 1000000;
   bool verbose = false;
   std::string scene_file = "config/scenes/default.yaml", impl = "god", config_file, out_dir;
   std::string marker_config = "config/services/marker_detector.yaml";
@@ -70,6 +75,8 @@ int main(int argc, char** argv) {
       if (!integer(&seed)) return usage("--seed must be a non-negative integer");
     } else if (a == "--overlays") {
       if (!integer(&overlays)) return usage("--overlays must be a non-negative integer");
+    } else if (a == "--first-utime") {
+      if (!integer(&first_utime)) return usage("--first-utime must be a non-negative integer");
     } else if (a == "--scene") {
       scene_file = v;
     } else if (a == "--impl") {
@@ -110,7 +117,7 @@ int main(int argc, char** argv) {
       bookgrasp::MarkerDetectorNode markers(md_settings);
       bookgrasp::BwsDetectorNode bws(bws_settings);
       bookgrasp::sim_render::SimCameraRig rig(scene_file, s);
-      const auto rendered = bookgrasp::eval_bws::render_scene(rig, 1000000);
+      const auto rendered = bookgrasp::eval_bws::render_scene(rig, first_utime);
       cv::Mat overlay;
       results.push_back(bookgrasp::eval_bws::evaluate_scene(rendered, s, markers, bws, &overlay));
       const auto& r = results.back();

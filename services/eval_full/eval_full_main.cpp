@@ -37,6 +37,8 @@ void usage(std::ostream& os) {
         "  --hand-hz R        hand camera frame rate (default: hand_camera.yaml)\n"
         "  --log              record each scene's bus (no images) to DIR/logs/seed_<S>.lcmlog\n"
         "  --log-channels A,B,...  with --log: record only these channels (e.g. the arbiter's, for a replay sample)\n"
+        "  --log-images       with --log: also record STEREO_IMAGES, HAND_IMAGE and BWS_DEBUG_IMAGE (large), to\n"
+        "                     replay a detector on the cycle's own frames\n"
         "  --snapshots        PNGs of the hand/stereo images (with what was detected, and the hand image raw) at\n"
         "                     every state change in DIR/snapshots/seed_<S>/\n"
         "  --snapshot-period-s P  with --snapshots: also a hand image every P s while a servo runs\n"
@@ -123,7 +125,7 @@ int main(int argc, char** argv) {
   double snapshot_period = 0;
   double budget = -1, done_after = 1.0, stereo_hz = 0, hand_hz = 0;
   std::string out, scene_file, source_dir = BOOKGRASP_SOURCE_DIR;
-  bool log = false, snapshots = false, verbose = false, resume = false;
+  bool log = false, log_images = false, snapshots = false, verbose = false, resume = false;
   std::vector<std::string> merge;
   std::vector<std::string> overrides, log_channels;
   std::ostringstream cmd;
@@ -151,6 +153,8 @@ int main(int argc, char** argv) {
       else if (a == "--source-dir") source_dir = value();
       else if (a == "--set") overrides.push_back(value());
       else if (a == "--log") log = true;
+      else if (a == "--log-images")
+        log_images = true;
       else if (a == "--log-channels")
         log_channels = channel_list(value());
       else if (a == "--snapshots") snapshots = true;
@@ -171,6 +175,7 @@ int main(int argc, char** argv) {
     if (merge.empty() && seed < 0) throw std::invalid_argument("--seed S (>= 0) is required");
     if (out.empty()) throw std::invalid_argument("--out DIR is required");
     if (books < 0) throw std::invalid_argument("--books must be >= 0");
+    if (log_images && !log) throw std::invalid_argument("--log-images records with --log: add --log");
   } catch (const std::exception& e) {
     std::cerr << "bookgrasp_eval_full: " << e.what() << "\n";
     usage(std::cerr);
@@ -235,6 +240,7 @@ int main(int argc, char** argv) {
     o.snapshot_period_s = snapshot_period;
     if (log) o.log_file = out + "/logs/seed_" + std::to_string(s) + ".lcmlog";
     o.log_channels = log_channels;
+    o.log_images = log_images;
     if (snapshots) o.snapshot_dir = out + "/snapshots/seed_" + std::to_string(s);
     std::optional<SceneOutcome> ran_scene;
     try {

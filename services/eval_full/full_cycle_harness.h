@@ -43,7 +43,7 @@ struct FullCycleOptions {
   double hand_rate_hz = 0;           ///< > 0 overrides hand_camera sim.frame_rate_hz
   double physics_step_s = 0.01;      ///< simulation time per harness step (then the bus is spun)
   std::string log_file;              ///< "" = no log; else an LCM log of the bus (message time stamps)
-  bool log_images = false;           ///< also log STEREO_IMAGES and HAND_IMAGE (large)
+  bool log_images = false;           ///< also log STEREO_IMAGES, HAND_IMAGE and BWS_DEBUG_IMAGE (large)
   std::vector<std::string> log_channels;  ///< not empty: log only these channels (e.g. a service's)
   std::string snapshot_dir;          ///< "" = none; else PNGs of the stereo/hand images at state changes
   double snapshot_period_s = 0;      ///< > 0: also a hand snapshot this often while a servo runs

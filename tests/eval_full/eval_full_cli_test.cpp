@@ -41,4 +41,13 @@ TEST(EvalFullTool, ABadOverrideStopsBeforeAnySceneAndRecordsNothing) {
   }
 }
 
+TEST(EvalFullTool, LogImagesWithoutLogIsRefusedByName) {
+  const std::string out = ::testing::TempDir() + "/eval_full_log_images";
+  std::filesystem::remove_all(out);
+  std::string err;
+  EXPECT_EQ(run_tool("--scenes 1 --seed 1 --out " + out + " --log-images", &err), 2);
+  EXPECT_NE(err.find("--log-images records with --log"), std::string::npos) << err;
+  EXPECT_FALSE(std::filesystem::exists(out + "/scenes")) << "no scene may have run";
+}
+
 }  // namespace
