@@ -142,6 +142,8 @@ std::optional<TriangulatedCorner> triangulate_corner(const std::vector<CornerSig
   if (out.rms_px > params.max_rms_px)
     return fail(format_text("R does not stay one point: RMS %.2f px > %.2f px over the %d views that agree", out.rms_px,
                             params.max_rms_px, out.sightings));
+  for (size_t i = 0; i < rays.size(); ++i)
+    if (in_front_of(rays[i], out.point) && view_error_px(rays[i], out.point, k) <= inlier_px) out.agreeing.push_back(i);
   return out;
 }
 

@@ -34,6 +34,9 @@ struct TriangulatedCorner {
   double baseline_m = 0;                            ///< largest distance between two camera centres
   double rms_px = 0;                                ///< RMS of the views' errors (pixels)
   int sightings = 0;                                ///< views used
+  /// Indices into the sightings of every view whose ray passes within 2 x max_rms_px of `point` (also those
+  /// left out of the search when there were more than it takes): the views that saw R at this corner.
+  std::vector<size_t> agreeing;
 };
 
 /// The point nearest to the viewing rays of the largest set of sightings that agree (each within 2 x max_rms_px

@@ -237,10 +237,11 @@ void set_next_fore_edge(const std::vector<ForeEdgeCandidate>& candidates, BookOb
   obs->neighbour_width_px = next->width_px;
 }
 
-double ServoSession::metres_at(const Eigen::Vector3d& corner_in_base, double (*pixels)(const ViewExtents&)) const {
+double ServoSession::metres_at(const TriangulatedCorner& corner, double (*pixels)(const ViewExtents&)) const {
   std::vector<double> widths;
-  for (size_t i = 0; i < sightings_.size(); ++i) {
-    const double depth = (sightings_[i].camera_in_base.inverse() * corner_in_base).z();
+  for (size_t i : corner.agreeing) {
+    if (i >= sightings_.size()) continue;
+    const double depth = (sightings_[i].camera_in_base.inverse() * corner.point).z();
     const double px = pixels(sighting_extents_[i]);
     if (px > 0 && depth > 0) widths.push_back(px * depth / geo_.intrinsics().fx);
   }
@@ -282,10 +283,10 @@ SessionOutput ServoSession::on_book(const BookObservation& obs) {
       const Eigen::Vector3d in_tcp = at_capture ? at_capture->inverse() * corner->point : Eigen::Vector3d::Zero();
       message += fmt("; R triangulated %.1f mm ahead of the TCP", in_tcp.z() * 1e3) +
                  fmt(" from %.0f views over %.1f mm", corner->sightings, corner->baseline_m * 1e3);
-      front_width = metres_at(corner->point, [](const ViewExtents& v) { return v.width_px; });
+      front_width = metres_at(*corner, [](const ViewExtents& v) { return v.width_px; });
       if (front_width > 0) message += fmt("; fore-edge %.1f mm wide", front_width * 1e3);
-      neighbour_offset = metres_at(corner->point, [](const ViewExtents& v) { return v.neighbour_offset_px; });
-      neighbour_width = metres_at(corner->point, [](const ViewExtents& v) { return v.neighbour_width_px; });
+      neighbour_offset = metres_at(*corner, [](const ViewExtents& v) { return v.neighbour_offset_px; });
+      neighbour_width = metres_at(*corner, [](const ViewExtents& v) { return v.neighbour_width_px; });
       if (neighbour_offset > 0 && neighbour_width > 0)
         message +=
             fmt("; the next fore-edge %.1f mm left of R, %.1f mm wide", neighbour_offset * 1e3, neighbour_width * 1e3);

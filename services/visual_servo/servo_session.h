@@ -169,9 +169,10 @@ class ServoSession {
   struct ViewExtents {
     double width_px = 0, neighbour_offset_px = 0, neighbour_width_px = 0;
   };
-  /// The median over the corner task's views of `pixels(view)` x (depth of `corner_in_base` in that view's camera)
-  /// / fx, over the views where `pixels` is > 0: a length across the fore-edges at R's depth (m); 0 = none.
-  double metres_at(const Eigen::Vector3d& corner_in_base, double (*pixels)(const ViewExtents&)) const;
+  /// The median of `pixels(view)` x (depth of the corner in that view's camera) / fx over the views that saw R at
+  /// the triangulated corner (`corner.agreeing`: R detected on another book on the way measured that book's
+  /// fore-edge, far_cart seed 5345) where `pixels` is > 0: a length across the fore-edges at R's depth (m); 0 = none.
+  double metres_at(const TriangulatedCorner& corner, double (*pixels)(const ViewExtents&)) const;
   void advance(int64_t utime, SessionOutput* out);
   void finish(ServoState state, const std::string& message, SessionOutput* out,
               const std::optional<Eigen::Isometry3d>& pose = std::nullopt);

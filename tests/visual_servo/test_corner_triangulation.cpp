@@ -87,6 +87,7 @@ TEST(CornerTriangulation, AViewOfAnotherPointIsDropped) {
   ASSERT_TRUE(t.has_value()) << why;
   EXPECT_EQ(t->sightings, 8);
   EXPECT_LT((t->point - kCorner).norm(), 1e-9);
+  EXPECT_EQ(t->agreeing, (std::vector<size_t>{0, 1, 3, 4, 5, 7, 8, 9}));  // the views that saw R here
   // Early views of a point far off put the least-squares point behind them: they are dropped too.
   std::vector<CornerSighting> far_off = upward_views(0.06, 12);
   for (int i = 0; i < 3; ++i) far_off[i].pixel = Eigen::Vector2d(20.0 + 10 * i, 470.0);

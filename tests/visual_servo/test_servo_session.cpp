@@ -320,9 +320,12 @@ TEST(StripeServoLatency, ImagesASecondLateStillConvergeOnTheTrueEnd) {
 /// The corner servo with images `latency_s` late (run_with_late_images); the corner 4 cm up and 3 cm right of the
 /// start and `corner_z` ahead of it (the servo assumes 0.22 m), its top edge rolled 3 degrees. Returns the final
 /// report.
+/// With `other_corner_views` > 0 BwH first takes other books' corners for R, that many views in all, in turns among
+/// three 12 mm wide fore-edges left of the target (as far_cart seed 5345's did on the way up).
 ServoReport run_late_corner(double latency_s, bool compensate, double corner_z = 0.22, double target_above_m = 0.0,
                             Eigen::Isometry3d* final_tcp = nullptr, bool bwh_gives_width = true,
-                            double neighbour_offset_m = 0.0, double neighbour_width_m = 0.0) {
+                            double neighbour_offset_m = 0.0, double neighbour_width_m = 0.0,
+                            int other_corner_views = 0) {
   const HandEyeGeometry geo = test::project_geometry();
   BookCornerServoParams cp;
   cp.target_above_tcp_m = target_above_m;
@@ -345,10 +348,18 @@ ServoReport run_late_corner(double latency_s, bool compensate, double corner_z =
   r.mode = ServoMode::kBookCorner;
   r.standoff_m = 0.22;
   r.timeout_s = 20;
+  std::vector<test::CornerScene> others(3, scene);
+  others[0].corner += Eigen::Vector3d(-0.02, -0.035, 0.01);
+  others[1].corner += Eigen::Vector3d(-0.04, -0.06, 0.0);
+  others[2].corner += Eigen::Vector3d(0.0, -0.08, -0.01);
+  for (auto& other : others) other.width_m = 0.012;
+  int captures = 0;
   const auto capture = [&](int64_t t, const Eigen::Isometry3d& at) {
     BookObservation o;
     o.utime = t;
-    o.found = scene.observe(geo, at, &o.r_px, &o.slope_rad, bwh_gives_width ? &o.width_px : nullptr);
+    const int c = captures++;
+    const test::CornerScene& seen = c < other_corner_views ? others[size_t(c % 3)] : scene;
+    o.found = seen.observe(geo, at, &o.r_px, &o.slope_rad, bwh_gives_width ? &o.width_px : nullptr);
     if (o.found) scene.observe_neighbour(geo, at, &o.neighbour_offset_px, &o.neighbour_width_px);
     return o;
   };
@@ -449,6 +460,15 @@ TEST(CornerServoTriangulation, TheConvergedReportLocatesRAtItsTrueDepth) {
     EXPECT_NEAR(next.neighbour_width_m, 0.018, 1e-3) << next.message;
     EXPECT_NE(next.message.find("the next fore-edge 32."), std::string::npos) << next.message;
   }
+  // BwH took other books' (12 mm) corners for R in the first 24 views, more views than the target's: the width comes
+  // from the views that saw R at the triangulated corner (it was 17.6 mm for a 30.4 mm book on far_cart seed 5345,
+  // whose open left plate then pushed the book in).
+  const ServoReport detour = run_late_corner(0.0, true, 0.22, 0.0, nullptr, true, 0.0, 0.0, 24);
+  ASSERT_EQ(detour.state, ServoState::kConverged) << detour.message;
+  ASSERT_TRUE(detour.corner.has_value()) << detour.message;
+  EXPECT_LT((detour.corner->point - Eigen::Vector3d(0.04, 0.03, 0.22)).norm(), 2e-3);
+  EXPECT_LT(detour.corner->agreeing.size(), 24u) << "the test needs the other corners' views to be the majority";
+  EXPECT_NEAR(detour.front_width_m, 0.03, 1e-3) << detour.message;
   // The assumed depth's error shows in the converged pose's X, not in the triangulated corner.
   const ServoReport deep = run_late_corner(0.0, true, 0.28);
   EXPECT_GT(std::abs(deep.converged_pose->translation().x() - 0.04), 0.01);
