@@ -298,6 +298,24 @@ void LibraryCycle::check_timeout() {
   deadline_ = -1;
   const std::string what = cycle_state_name(state_);
   if (state_ == CycleState::kWaitMarkers) {
+    // A restarted coordinator whose view of a tag the held book (or the stopped arm) hides: the cart and the holder
+    // stood still through the task, so the poses persisted before the restart stand in (kill test, 2026-12-06).
+    const bool cart_from_progress = !cart_marker_ && progress_.cart_marker_in_base;
+    const bool holder_from_progress = !holder_marker_ && progress_.holder_marker_in_base;
+    if ((cart_from_progress || holder_from_progress) && (cart_marker_ || cart_from_progress) &&
+        (holder_marker_ || holder_from_progress)) {
+      if (cart_from_progress) cart_marker_ = progress_.cart_marker_in_base;
+      if (holder_from_progress) holder_marker_ = progress_.holder_marker_in_base;
+      message_ = std::string("resuming with the ") +
+                 (cart_from_progress && holder_from_progress ? "cart and holder marker poses"
+                  : cart_from_progress                       ? "cart marker pose"
+                                                             : "holder marker pose") +
+                 " persisted before the restart: the tag was not seen within " + std::to_string(s_.markers_timeout_s) +
+                 " s (the held book or the arm in front of it?)";
+      status_changed_ = true;
+      set_deadline(s_.markers_timeout_s);
+      return;
+    }
     if (cart_marker_ && holder_marker_)
       abort("timeout in WAIT_MARKERS: the arm is still executing a motion the coordinator did not start, " +
             std::string("and did not stop on ARM_COMMAND STOP within ") + std::to_string(s_.markers_timeout_s) + " s");
@@ -1178,8 +1196,8 @@ bool LibraryCycle::stripe_left_limit_passed() {
 std::vector<CycleRequest> LibraryCycle::on_markers(const MarkersEvent& e) {
   out_.clear();
   advance_time(e.utime);
-  if (e.cart) cart_marker_ = e.cart;
-  if (e.holder) holder_marker_ = e.holder;
+  if (e.cart) cart_marker_ = progress_.cart_marker_in_base = e.cart;  // written with the next state's progress
+  if (e.holder) holder_marker_ = progress_.holder_marker_in_base = e.holder;
   check_timeout();
   return out_;
 }

@@ -4,6 +4,7 @@
 #include <unistd.h>
 
 #include <cerrno>
+#include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <fstream>
@@ -43,6 +44,29 @@ T need(const YAML::Node& n, const std::string& key, const std::string& source) {
     throw std::runtime_error(source + ": key '" + key + "' has the wrong type: " + e.what());
   }
 }
+/// A pose as [x, y, z, qw, qx, qy, qz] (the YAML form of the marker poses).
+void emit_pose(YAML::Emitter& e, const char* key, const std::optional<Eigen::Isometry3d>& pose) {
+  if (!pose) return;
+  const Eigen::Quaterniond q(pose->linear());
+  const Eigen::Vector3d t = pose->translation();
+  e << YAML::Key << key << YAML::Value << YAML::Flow << YAML::BeginSeq << t.x() << t.y() << t.z() << q.w() << q.x()
+    << q.y() << q.z() << YAML::EndSeq;
+}
+
+std::optional<Eigen::Isometry3d> parse_pose(const YAML::Node& n, const std::string& key, const std::string& source) {
+  if (!n[key]) return std::nullopt;
+  const auto v = need<std::vector<double>>(n, key, source);
+  bool finite = v.size() == 7;
+  for (double x : v) finite = finite && std::isfinite(x);
+  const Eigen::Quaterniond q = finite ? Eigen::Quaterniond(v[3], v[4], v[5], v[6]) : Eigen::Quaterniond::Identity();
+  if (!finite || std::abs(q.norm() - 1.0) > 1e-3)
+    throw std::runtime_error(source + ": '" + key +
+                             "' must be 7 finite numbers [x, y, z, qw, qx, qy, qz] with a unit quaternion");
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+  pose.linear() = q.normalized().toRotationMatrix();
+  pose.translation() = Eigen::Vector3d(v[0], v[1], v[2]);
+  return pose;
+}
 }  // namespace
 
 std::string progress_to_yaml(const TaskProgress& p) {
@@ -67,7 +91,10 @@ std::string progress_to_yaml(const TaskProgress& p) {
       << YAML::Value << b.width << YAML::Key << "gp_y" << YAML::Value << b.gp_y << YAML::Key << "lower_right_y"
       << YAML::Value << b.lower_right_y << YAML::Key << "handed_over" << YAML::Value << b.handed_over << YAML::Key
       << "height" << YAML::Value << b.height << YAML::EndMap;
-  e << YAML::EndSeq << YAML::EndMap;
+  e << YAML::EndSeq;
+  emit_pose(e, "cart_marker_in_base", p.cart_marker_in_base);
+  emit_pose(e, "holder_marker_in_base", p.holder_marker_in_base);
+  e << YAML::EndMap;
   return std::string(e.c_str()) + "\n";
 }
 
@@ -107,6 +134,8 @@ TaskProgress progress_from_yaml(const std::string& text, const std::string& sour
     m.height = b["height"] ? need<double>(b, "height", source) : std::numeric_limits<double>::quiet_NaN();  // stop 32
     p.moved.push_back(m);
   }
+  p.cart_marker_in_base = parse_pose(n, "cart_marker_in_base", source);  // absent before stop 40
+  p.holder_marker_in_base = parse_pose(n, "holder_marker_in_base", source);
   if (p.books_moved < 0 || p.books_moved != static_cast<int>(p.moved.size()))
     throw std::runtime_error(source + ": books_moved (" + std::to_string(p.books_moved) +
                              ") does not match the list 'moved' (" + std::to_string(p.moved.size()) + " entries)");

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 
 namespace bookgrasp {
 
@@ -58,6 +59,11 @@ struct TaskProgress {
   std::string hand_over_reason;
   std::string last_state;                 ///< state-machine state when written
   std::vector<MovedBook> moved;           ///< the books moved, in order
+  /// The cart and holder marker poses (base) last seen: the cart and the holder stand still through a task. A
+  /// restarted coordinator that does not see a tag within timeouts.markers_s (the held book or the stopped arm in
+  /// front of it) resumes with these. Absent before the first sighting and in files written before stop 40.
+  std::optional<Eigen::Isometry3d> cart_marker_in_base;
+  std::optional<Eigen::Isometry3d> holder_marker_in_base;  ///< see cart_marker_in_base
 };
 
 /// The progress as YAML text.

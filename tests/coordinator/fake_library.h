@@ -132,6 +132,7 @@ class FakeLibrary {
   std::vector<double> joints = std::vector<double>(7, 0.0);  ///< reported joints
   std::vector<std::string> user_events_sent;
   std::optional<Eigen::Vector3d> ps;        ///< the fake arbiter's PS
+  bool cart_tag_hidden = false;             ///< MARKERS without the cart tag (the held book in front of it)
 
   /// Advances 10 ms: an arm state (and markers every 100 ms) to `cycle`, answering its requests.
   void tick(LibraryCycle& cycle) {
@@ -142,7 +143,7 @@ class FakeLibrary {
     if ((t / 10000) % 10 == 0 || !markers_sent_) {
       bookgrasp::MarkersEvent m;
       m.utime = t;
-      m.cart = cart_marker_pose();
+      if (!cart_tag_hidden) m.cart = cart_marker_pose();
       m.holder = holder_marker_pose();
       handle(cycle, cycle.on_markers(m));
       markers_sent_ = true;

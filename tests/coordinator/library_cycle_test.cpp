@@ -701,6 +701,39 @@ TEST(LibraryCycle, ACoordinatorRestartedAfterAShallowGraspExtractsAndPlansWithIt
       << " without";
 }
 
+// A coordinator restarted while it carries a book to the holder, with the held book in front of the cart tag: it
+// resumes with the cart pose persisted before the restart once timeouts.markers_s has passed, and the book reaches the
+// holder. Without a persisted pose (a progress file from before stop 40) it aborts as before (the kill test,
+// 2026-12-06).
+TEST(LibraryCycle, ARestartedCoordinatorThatCannotSeeTheCartTagResumesWithItsPersistedPose) {
+  const auto restart_with_tag_hidden = [](bool persisted) {
+    FakeLibrary w(three_books());
+    auto first = std::make_unique<LibraryCycle>(settings(), std::nullopt);
+    w.run(*first, [&] { return first->state() == CycleState::kMoveToHolder; });
+    bookgrasp::TaskProgress progress =
+        bookgrasp::progress_from_yaml(bookgrasp::progress_to_yaml(first->progress()), "restart");
+    EXPECT_TRUE(progress.cart_marker_in_base.has_value());
+    EXPECT_TRUE(progress.holder_marker_in_base.has_value());
+    if (progress.cart_marker_in_base)
+      EXPECT_LT((progress.cart_marker_in_base->translation() - cart_marker_pose().translation()).norm(), 1e-9);
+    if (!persisted) progress.cart_marker_in_base.reset();
+    first.reset();
+    w.cart_tag_hidden = true;
+    LibraryCycle second(settings(), progress);
+    w.run(second, [&] { return second.state() == CycleState::kWaitUser || done_or_aborted(second); });
+    return std::pair{second.state(), w.messages};
+  };
+  const auto [state, messages] = restart_with_tag_hidden(true);
+  EXPECT_EQ(state, CycleState::kWaitUser) << messages.back();
+  EXPECT_TRUE(std::any_of(messages.begin(), messages.end(), [](const std::string& m) {
+    return m.find("resuming with the cart marker pose persisted before the restart") != std::string::npos;
+  }));
+  const auto [old_state, old_messages] = restart_with_tag_hidden(false);
+  EXPECT_EQ(old_state, CycleState::kAborted);
+  EXPECT_NE(old_messages.back().find("cart and holder markers not both seen"), std::string::npos)
+      << old_messages.back();
+}
+
 TEST(LibraryCycle, TheShippedPlateCheckSeparatesTheMeasuredGraspsFromTheDoubleLifts) {
   // Plates minus the corner servo's fore-edge (eval full's plates_over_fore_edge_mm): -6.8..+1.6 mm over 188 closes
   // that held the book alone (stop 28's 500 scenes, traced, and stop 29's 76 seeds); the double lifts closed 3.06,
@@ -1427,6 +1460,34 @@ TEST(TaskProgress, RoundTripAndCorruptFilesAreNamed) {
     EXPECT_NE(std::string(e.what()).find("books_moved"), std::string::npos) << e.what();
   }
   EXPECT_FALSE(bookgrasp::load_progress(testing::TempDir() + "/does_not_exist.yaml"));
+}
+
+// The marker poses persisted for a restart: written, read back to the bit-exact translation and rotation (within
+// float rounding), absent in older files, and a malformed one names its key.
+TEST(TaskProgress, TheMarkerPosesRoundTripAndAMalformedOneIsNamed) {
+  bookgrasp::TaskProgress p;
+  p.last_state = "MOVE_TO_HOLDER";
+  Eigen::Isometry3d cart = Eigen::Isometry3d::Identity();
+  cart.translate(Eigen::Vector3d(1.2, -0.3, 0.45))
+      .rotate(Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 2, 3).normalized()));
+  p.cart_marker_in_base = cart;
+  const auto q = bookgrasp::progress_from_yaml(bookgrasp::progress_to_yaml(p), "test");
+  ASSERT_TRUE(q.cart_marker_in_base.has_value());
+  EXPECT_FALSE(q.holder_marker_in_base.has_value());
+  EXPECT_TRUE(q.cart_marker_in_base->matrix().isApprox(cart.matrix(), 1e-12));
+  const std::string head =
+      "books_moved: 0\nfailures: 0\nplace: gripper_from_shelf\nhave_book_data: false\ngp_grasp: [0, 0, 0]\n"
+      "book_width: 0\nlower_next_right_y: 0\nfinished: false\nlast_state: MOVE_TO_HOLDER\nmoved: []\n";
+  EXPECT_FALSE(bookgrasp::progress_from_yaml(head, "old.yaml").cart_marker_in_base.has_value());
+  for (const std::string& bad : {"cart_marker_in_base: [1, 2, 3]\n", "cart_marker_in_base: [1, 2, 3, .nan, 0, 0, 0]\n",
+                                 "holder_marker_in_base: [1, 2, 3, 2, 0, 0, 0]\n"}) {
+    try {
+      bookgrasp::progress_from_yaml(head + bad, "p.yaml");
+      ADD_FAILURE() << "accepted " << bad;
+    } catch (const std::runtime_error& e) {
+      EXPECT_NE(std::string(e.what()).find(bad.substr(0, bad.find(':'))), std::string::npos) << e.what();
+    }
+  }
 }
 
 // A book the plates keep missing on the holder: each miss backs out and comes back (BACK_OUT_FROM_HOLDER ..
