@@ -302,10 +302,9 @@ void LibraryCycle::check_timeout() {
     // stood still through the task, so the poses persisted before the restart stand in (kill test, 2026-12-06).
     const bool cart_from_progress = !cart_marker_ && progress_.cart_marker_in_base;
     const bool holder_from_progress = !holder_marker_ && progress_.holder_marker_in_base;
-    if ((cart_from_progress || holder_from_progress) && (cart_marker_ || cart_from_progress) &&
-        (holder_marker_ || holder_from_progress)) {
-      if (cart_from_progress) cart_marker_ = progress_.cart_marker_in_base;
-      if (holder_from_progress) holder_marker_ = progress_.holder_marker_in_base;
+    if (!cart_marker_) cart_marker_ = progress_.cart_marker_in_base;
+    if (!holder_marker_) holder_marker_ = progress_.holder_marker_in_base;
+    if ((cart_from_progress || holder_from_progress) && cart_marker_ && holder_marker_) {
       message_ = std::string("resuming with the ") +
                  (cart_from_progress && holder_from_progress ? "cart and holder marker poses"
                   : cart_from_progress                       ? "cart marker pose"

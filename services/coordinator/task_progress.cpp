@@ -3,8 +3,8 @@
 #include <fcntl.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
-#include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <fstream>
@@ -13,6 +13,8 @@
 #include <stdexcept>
 
 #include <yaml-cpp/yaml.h>
+
+#include "common/pose_conversion.h"
 
 namespace bookgrasp {
 
@@ -44,28 +46,29 @@ T need(const YAML::Node& n, const std::string& key, const std::string& source) {
     throw std::runtime_error(source + ": key '" + key + "' has the wrong type: " + e.what());
   }
 }
-/// A pose as [x, y, z, qw, qx, qy, qz] (the YAML form of the marker poses).
+/// A pose as [x, y, z, qw, qx, qy, qz] (the YAML form of the marker poses), as pose_t orders it.
 void emit_pose(YAML::Emitter& e, const char* key, const std::optional<Eigen::Isometry3d>& pose) {
   if (!pose) return;
-  const Eigen::Quaterniond q(pose->linear());
-  const Eigen::Vector3d t = pose->translation();
-  e << YAML::Key << key << YAML::Value << YAML::Flow << YAML::BeginSeq << t.x() << t.y() << t.z() << q.w() << q.x()
-    << q.y() << q.z() << YAML::EndSeq;
+  const pose_t p = isometry_to_pose(*pose, "base", key, 0);
+  e << YAML::Key << key << YAML::Value << YAML::Flow << YAML::BeginSeq << p.position[0] << p.position[1]
+    << p.position[2] << p.orientation[0] << p.orientation[1] << p.orientation[2] << p.orientation[3] << YAML::EndSeq;
 }
 
 std::optional<Eigen::Isometry3d> parse_pose(const YAML::Node& n, const std::string& key, const std::string& source) {
   if (!n[key]) return std::nullopt;
   const auto v = need<std::vector<double>>(n, key, source);
-  bool finite = v.size() == 7;
-  for (double x : v) finite = finite && std::isfinite(x);
-  const Eigen::Quaterniond q = finite ? Eigen::Quaterniond(v[3], v[4], v[5], v[6]) : Eigen::Quaterniond::Identity();
-  if (!finite || std::abs(q.norm() - 1.0) > 1e-3)
-    throw std::runtime_error(source + ": '" + key +
-                             "' must be 7 finite numbers [x, y, z, qw, qx, qy, qz] with a unit quaternion");
-  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
-  pose.linear() = q.normalized().toRotationMatrix();
-  pose.translation() = Eigen::Vector3d(v[0], v[1], v[2]);
-  return pose;
+  if (v.size() != 7) throw std::runtime_error(source + ": '" + key + "' must be 7 numbers [x, y, z, qw, qx, qy, qz]");
+  pose_t p;
+  p.utime = 0;
+  p.frame = "base";
+  p.child = key;
+  std::copy(v.begin(), v.begin() + 3, p.position);
+  std::copy(v.begin() + 3, v.end(), p.orientation);
+  try {
+    return pose_to_isometry(p);
+  } catch (const PoseError& e) {
+    throw std::runtime_error(source + ": '" + key + "': " + e.what());
+  }
 }
 }  // namespace
 
