@@ -10,6 +10,8 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "services/eval_hand/hand_eval_metrics.h"
+
 namespace bookgrasp {
 
 namespace {
@@ -100,6 +102,7 @@ double rate(int k, int n) { return n > 0 ? static_cast<double>(k) / n : NAN; }
 }  // namespace
 
 void write_report(const std::string& dir, const EvalMetrics& m, const std::string& command, int books_per_scene) {
+  const MetricTolerances tol;  // the ones eval_full measures with
   // Plots (PNG, OpenCV).
   cv::imwrite(dir + "/rates.png",
               rates_plot({"grasp", "P1-P2 agree", "width<1cm", "books moved", "upright"},
@@ -117,6 +120,8 @@ void write_report(const std::string& dir, const EvalMetrics& m, const std::strin
     cv::imwrite(dir + "/p1_error_" + ax[k] + ".png",
                 histogram(m.p1_error_mm[k], 0, 30, 30, std::string("P1 error |") + ax[k] + "| vs truth (paper Fig. 12)",
                           "mm", {}));
+  cv::imwrite(dir + "/figure14_stripe_end.png", stripe_end_figure(m.stripe_error_mm[0], m.stripe_error_mm[1],
+                                                                  tol.stripe_x_m * 1e3, tol.stripe_y_m * 1e3));
   cv::imwrite(dir + "/cycle_time.png", histogram(m.cycle_s, 0, 300, 30, "cycle time per moved book", "s", {}));
   cv::imwrite(dir + "/planning_time.png", histogram(m.plan_ms, 0, 2000, 40, "planning time per request", "ms", {2000}));
 
@@ -140,6 +145,15 @@ void write_report(const std::string& dir, const EvalMetrics& m, const std::strin
      << m.books_handed_over - m.books_handed_over_unplaceable << " / " << m.books_handed_over_unplaceable << " | - |\n";
   md << "| P1-P2 agreement (|dY| <= 15 mm, |dX| <= 20 mm) | " << pct(m.decisions_agreeing, m.decisions) << " | 80 % |\n";
   md << "| book width within 1 cm | " << pct(m.widths_within, m.widths) << " | 65 % |\n";
+  {
+    const Stats sx = stats_of(m.stripe_error_mm[0]), sy = stats_of(m.stripe_error_mm[1]);
+    md << "| stripe end PS within " << f2(tol.stripe_x_m * 1e3, "%.0f") << " mm X and "
+       << f2(tol.stripe_y_m * 1e3, "%.0f") << " mm Y of the truth | " << pct(m.stripes_within, m.stripes)
+       << " | every time (Fig. 14) |\n";
+    md << "| stripe end error X / Y mean, min / max | " << f2(sx.mean, "%.1f") << " (" << f2(sx.min, "%.1f") << " / "
+       << f2(sx.max, "%.1f") << ") / " << f2(sy.mean, "%.1f") << " (" << f2(sy.min, "%.1f") << " / "
+       << f2(sy.max, "%.1f") << ") mm | - |\n";
+  }
   md << "| book width error mean / max | " << f2(w.mean, "%.1f") << " / " << f2(w.max, "%.1f") << " mm | - |\n";
   for (int k = 0; k < 3; ++k) {
     const Stats e = stats_of(m.p1_error_mm[k]);
@@ -168,7 +182,7 @@ void write_report(const std::string& dir, const EvalMetrics& m, const std::strin
   md << "| planning time mean / max | " << f2(p.mean, "%.0f") << " / " << f2(p.max, "%.0f") << " ms | < 2 s |\n\n";
   md << "![rates](rates.png)\n![width error](width_error.png)\n![P1-P2](p1_p2_y.png)\n"
         "![P1 x](p1_error_x.png)\n![P1 y](p1_error_y.png)\n![P1 z](p1_error_z.png)\n"
-        "![cycle](cycle_time.png)\n![planning](planning_time.png)\n\n";
+        "![stripe end](figure14_stripe_end.png)\n![cycle](cycle_time.png)\n![planning](planning_time.png)\n\n";
   md << "## Failure modes\n\n";
   if (m.failure_modes.empty()) md << "None.\n";
   for (const auto& [why, n] : m.failure_modes) md << "- " << n << " x " << why << "\n";

@@ -23,6 +23,7 @@
 #include "bookgrasp/hand_image_t.hpp"
 #include "bookgrasp/marker_detections_t.hpp"
 #include "bookgrasp/plan_result_t.hpp"
+#include "bookgrasp/servo_request_t.hpp"
 #include "bookgrasp/servo_status_t.hpp"
 #include "bookgrasp/stereo_frame_t.hpp"
 #include "bookgrasp/stripe_features_t.hpp"
@@ -161,6 +162,7 @@ struct FullCycleHarness::Impl {
   double last_front_width = 0;  ///< the last converged corner servo's fore-edge width (0 = none)
   int64_t last_servo_trace = 0;
   stripe_features_t last_stripe_f{};
+  int64_t last_stripe_request = -1;  ///< the last STRIPE_END request recorded in res.stripes
   book_features_hand_t last_book_f{};
   // observations
   task_status_t status{};
@@ -408,6 +410,18 @@ struct FullCycleHarness::Impl {
     }
     last_servo_line = line;
     if (m->mode == 1 && m->state == servo_status_t::CONVERGED) last_front_width = m->front_width_m;  // BOOK_CORNER
+    if (m->mode == servo_request_t::STRIPE_END && m->state == servo_status_t::CONVERGED &&
+        m->request_id != last_stripe_request && is_valid_pose(m->converged_pose)) {  // it repeats its final status
+      last_stripe_request = m->request_id;
+      const ground_truth_t gt = sim->world().model().ground_truth(sim->world().now_utime());
+      StripeRecord s;
+      s.book_index = status.current_book;
+      s.ps_true_grasp = true_grasp(pose_to_isometry(m->converged_pose).translation());
+      s.end_true_grasp = true_grasp(vec3(gt.stripe_end_base));
+      const Eigen::Vector3d e = (s.ps_true_grasp - s.end_true_grasp) * 1e3;
+      trace(fmt("TRUTH PS - true stripe end (%.1f, ", e.x()) + fmt("%.1f) mm (X, Y)", e.y()));
+      res.stripes.push_back(s);
+    }
   }
   void on_stripe(const lcm::ReceiveBuffer*, const std::string&, const stripe_features_t* m) {
     last_stripe_f = *m;

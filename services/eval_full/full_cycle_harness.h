@@ -11,9 +11,9 @@
 ///
 /// The harness steps physics in small steps of simulation time and spins the
 /// bus after each, so every component sees message time only. It watches
-/// TASK_STATUS, GRASP_POINT and SIM_GROUND_TRUTH and turns them into what the
-/// evaluation measures (grasp attempts and their physical outcome, P1-P2
-/// agreement, book width against the truth, cycle time per book). Used by
+/// TASK_STATUS, GRASP_POINT, SERVO_STATUS and SIM_GROUND_TRUTH and turns them into
+/// what the evaluation measures (grasp attempts and their physical outcome, P1-P2
+/// agreement, book width and stripe end against the truth, cycle time per book). Used by
 /// tests/coordinator/full_cycle_test.cpp and the tool bookgrasp_eval_full.
 
 #include <cstdint>
@@ -67,6 +67,15 @@ struct GraspDecisionRecord {
   Eigen::Vector3d gp_base_true_grasp = Eigen::Vector3d::Zero();
   bool truth_known = false;
   bool p1_valid = false;             ///< the arbiter used P1 (p1_used)
+};
+
+/// One converged stripe servo (BSwH, paper Section 2.3): PS, the TCP where the stripe end sat in the image centre,
+/// against the simulation's true stripe end (SIM_GROUND_TRUTH.stripe_end_base at that moment), both in the cart's
+/// true grasp frame. PS's Z is the servo's standoff, not a measurement, so only X and Y are compared (paper Fig. 14).
+struct StripeRecord {
+  int book_index = 0;                                        ///< coordinator's current book
+  Eigen::Vector3d ps_true_grasp = Eigen::Vector3d::Zero();   ///< PS in the cart's true grasp frame, m
+  Eigen::Vector3d end_true_grasp = Eigen::Vector3d::Zero();  ///< the true stripe end, same frame, m
 };
 
 /// One book taken (or tried) by the cycle.
@@ -123,6 +132,7 @@ struct FullCycleResult {
   std::vector<BookRecord> books;
   std::vector<GraspDecisionRecord> decisions;
   std::vector<PlateClose> closes;    ///< every close on the upper shelf with a measured fore-edge
+  std::vector<StripeRecord> stripes;  ///< every converged stripe servo
   ground_truth_t final_truth;        ///< latest SIM_GROUND_TRUTH
   double sim_s = 0;                  ///< simulation time used
   double wall_s = 0;                 ///< wall time used (incl. building)

@@ -180,6 +180,13 @@ void accumulate(const SceneOutcome& o, int max_books, const MetricTolerances& to
     if (d.truth_known)
       for (int k = 0; k < 3; ++k) m->p1_error_mm[k].push_back(std::abs(d.p1_grasp[k] - d.p1_true_grasp[k]) * 1e3);
   }
+  for (const StripeRecord& st : r.stripes) {
+    const Eigen::Vector3d e = st.ps_true_grasp - st.end_true_grasp;
+    ++m->stripes;
+    m->stripes_within += std::abs(e.x()) <= tol.stripe_x_m && std::abs(e.y()) <= tol.stripe_y_m ? 1 : 0;
+    m->stripe_error_mm[0].push_back(e.x() * 1e3);
+    m->stripe_error_mm[1].push_back(e.y() * 1e3);
+  }
   for (const auto& b : r.books) {
     if (b.measured_width_m >= 0 && b.truth_id >= 0 && b.grasp_successes > 0) {  // plates on a held book only
       ++m->widths;
@@ -274,6 +281,10 @@ std::string metrics_json(const EvalMetrics& m, const std::string& command) {
   j << "  \"gp_base_error_mm\": {\"x\": " << signed_stats_json(stats_of(m.gp_base_error_mm[0]))
     << ", \"y\": " << signed_stats_json(stats_of(m.gp_base_error_mm[1]))
     << ", \"z\": " << signed_stats_json(stats_of(m.gp_base_error_mm[2])) << "},\n";
+  j << "  \"stripes_measured\": " << m.stripes << ",\n";
+  j << "  \"stripe_within_tolerance_rate\": " << rate(m.stripes_within, m.stripes) << ",\n";
+  j << "  \"stripe_error_mm\": {\"x\": " << signed_stats_json(stats_of(m.stripe_error_mm[0]))
+    << ", \"y\": " << signed_stats_json(stats_of(m.stripe_error_mm[1])) << "},\n";
   j << "  \"plates_over_fore_edge_mm\": {";
   for (int k = 0; k < 4; ++k)
     j << (k ? ", " : "") << "\"" << kCloseOutcomes[k]

@@ -2,7 +2,7 @@
 /// @file
 /// The evaluation's figures over many scenes run by the full-cycle harness
 /// (paper Section 5): grasp success, P1-P2 agreement, book width error, P1
-/// error, cycle and planning time, failures by seed and reason.
+/// error, stripe end error, cycle and planning time, failures by seed and reason.
 
 #include <cstdint>
 #include <map>
@@ -24,6 +24,8 @@ struct MetricTolerances {
   double agreement_y_m = 0.015;  ///< P1-P2 agreement in Y (grasping tolerance)
   double agreement_x_m = 0.020;  ///< ... in X
   double width_m = 0.010;        ///< book width within this of the truth
+  double stripe_x_m = 0.015;     ///< stripe end (PS) within this of the truth in X (paper Sec. 5, Fig. 14)
+  double stripe_y_m = 0.010;     ///< ... and in Y
 };
 
 /// Summary statistics of a sample.
@@ -71,6 +73,9 @@ struct EvalMetrics {
   /// gp_error_mm (GP in the arbiter's own cart frame) does not show when the cart frame itself is off.
   std::vector<double> gp_base_error_mm[3];
   std::vector<double> p1_p2_dy_mm, p1_p2_dx_mm;  ///< P2 - P1 per decision
+  int stripes = 0;                               ///< converged stripe servos (StripeRecord)
+  int stripes_within = 0;  ///< ... with PS within MetricTolerances::stripe_x_m / stripe_y_m of the true end
+  std::vector<double> stripe_error_mm[2];  ///< PS - true stripe end (signed) per grasp-frame axis X, Y
   /// Plates minus the corner servo's fore-edge at each close (PlateClose), by outcome: kCloseOutcomes[k].
   std::vector<double> plates_over_fore_edge_mm[4];
   std::vector<double> cycle_s;               ///< per moved book, message time

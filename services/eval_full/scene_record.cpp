@@ -36,6 +36,8 @@ auto counts(M& m) {
       {"decisions_agreeing", &m.decisions_agreeing},
       {"widths", &m.widths},
       {"widths_within", &m.widths_within},
+      {"stripes", &m.stripes},
+      {"stripes_within", &m.stripes_within},
   };
 }
 
@@ -55,6 +57,8 @@ auto samples(M& m) {
       {"gp_base_error_mm_z", &m.gp_base_error_mm[2]},
       {"p1_p2_dy_mm", &m.p1_p2_dy_mm},
       {"p1_p2_dx_mm", &m.p1_p2_dx_mm},
+      {"stripe_error_mm_x", &m.stripe_error_mm[0]},
+      {"stripe_error_mm_y", &m.stripe_error_mm[1]},
       {"cycle_s", &m.cycle_s},
       {"plan_ms", &m.plan_ms},
       {"scene_wall_s", &m.scene_wall_s},
@@ -65,10 +69,11 @@ auto samples(M& m) {
   };
 }
 
-/// Keys added after the first scene records (stop 28: the plate samples; stop 31: the upright counts): a record
-/// without them measured none (empty, 0).
+/// Keys added after the first scene records (stop 28: the plate samples; stop 31: the upright counts; stop 41: the
+/// stripe end): a record without them measured none (empty, 0).
 bool added_later(const std::string& key) {
-  return key.rfind("plates_over_fore_edge_mm_", 0) == 0 || key.rfind("books_upright_", 0) == 0;
+  return key.rfind("plates_over_fore_edge_mm_", 0) == 0 || key.rfind("books_upright_", 0) == 0 ||
+         key.rfind("stripe", 0) == 0;
 }
 
 std::string exact(double v) {

@@ -348,6 +348,12 @@ std::string pct(int k, int n) {
 
 }  // namespace
 
+cv::Mat stripe_end_figure(const std::vector<double>& x_mm, const std::vector<double>& y_mm, double tol_x_mm,
+                          double tol_y_mm) {
+  return side_by_side(scatter("Figure 14: stripe end error (PS - true end)", x_mm, y_mm, tol_x_mm, tol_y_mm),
+                      per_scene("stripe end error per run", x_mm, y_mm, tol_x_mm, tol_y_mm, "mm"));
+}
+
 void write_hand_report(const std::string& dir, const HandEvalMetrics& m, const std::vector<HandSceneOutcome>& scenes,
                        const HandTolerances& tol, const std::string& command) {
   std::vector<double> sx, sy, px, py, pz, slope;
@@ -367,10 +373,7 @@ void write_hand_report(const std::string& dir, const HandEvalMetrics& m, const s
       per_scene("Figure 13: P2 - P1 (BwH servo vs true P1) per run", px, py, tol.p2_x_m * 1e3, tol.p2_y_m * 1e3, "mm"),
       per_scene("P2 depth error (Z - standoff) per run", pz, {}, 5.0, 5.0, "mm"));
   write_png(dir + "/figure13_p2_error.png", fig13);
-  const cv::Mat fig14 = side_by_side(
-      scatter("Figure 14: stripe end error (PS - true end)", sx, sy, tol.stripe_x_m * 1e3, tol.stripe_y_m * 1e3),
-      per_scene("stripe end error per run", sx, sy, tol.stripe_x_m * 1e3, tol.stripe_y_m * 1e3, "mm"));
-  write_png(dir + "/figure14_stripe_end.png", fig14);
+  write_png(dir + "/figure14_stripe_end.png", stripe_end_figure(sx, sy, tol.stripe_x_m * 1e3, tol.stripe_y_m * 1e3));
   write_png(dir + "/slope_error.png", per_scene("book slope error (gripper roll - true lean) per run", slope, {},
                                                 tol.slope_deg, tol.slope_deg, "deg"));
 

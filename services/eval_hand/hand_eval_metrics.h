@@ -10,6 +10,8 @@
 #include <string>
 #include <vector>
 
+#include <opencv2/core.hpp>
+
 namespace bookgrasp {
 
 /// One servo task's outcome, errors against the simulation's ground truth.
@@ -86,6 +88,12 @@ void accumulate(const HandSceneOutcome& o, const HandTolerances& tol, HandEvalMe
 /// signed errors in mm, converged TCP and the true point in base, so the errors can be checked).
 std::string hand_metrics_json(const HandEvalMetrics& m, const std::string& command,
                               const std::vector<HandSceneOutcome>& scenes = {});
+
+/// The paper's Figure 14 for the stripe end: PS - true end as a scatter (Y right, X up, mm) with the tolerance box
+/// (+-`tol_x_mm` X, +-`tol_y_mm` Y), beside the errors per run. `x_mm` and `y_mm` pair up by index. Also used by the
+/// full-cycle evaluation (services/eval_full/eval_report.h).
+cv::Mat stripe_end_figure(const std::vector<double>& x_mm, const std::vector<double>& y_mm, double tol_x_mm,
+                          double tol_y_mm);
 
 /// Writes `dir`/report.md, `dir`/figure13_p2_error.png (P2 - P1 per scene, X and Y with the grasping
 /// tolerance; Z), `dir`/figure14_stripe_end.png (stripe end error scatter Y vs X with the tolerance box,

@@ -4,6 +4,7 @@
 // never against the components' own outputs.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <filesystem>
 #include <map>
 #include <string>
@@ -95,6 +96,11 @@ TEST(FullCycle, FirstBookToHolderAndLowerShelf) {
   EXPECT_EQ(r.books[0].truth_id, first);
   ASSERT_GE(r.books[0].measured_width_m, 0) << "the arbiter reported no book width";
   EXPECT_NEAR(r.books[0].measured_width_m, r.books[0].true_width_m, 0.01) << "book width from the plates";
+  // The first book's PS is the stripe servo's (BSwH): within the paper's positioning tolerance of the true stripe end.
+  ASSERT_FALSE(r.stripes.empty()) << "no stripe servo converged in the first book's cycle";
+  const Eigen::Vector3d ps_error = r.stripes.front().ps_true_grasp - r.stripes.front().end_true_grasp;
+  EXPECT_LE(std::abs(ps_error.x()), 0.015) << "PS - true stripe end in X (up), m";
+  EXPECT_LE(std::abs(ps_error.y()), 0.010) << "PS - true stripe end in Y (right), m";
 }
 
 // The coordinator is destroyed with the book on the holder and rebuilt from its progress file: the new one

@@ -63,3 +63,24 @@ TEST(EvalReport, NoUprightBarWhenNoSceneCheckedIt) {
   ASSERT_FALSE(img.empty());
   EXPECT_EQ(pixel_in_upright_bar(img, 10), cv::Vec3b(255, 255, 255));
 }
+
+TEST(EvalReport, TheStripeEndHasItsFigureAndRow) {
+  const std::string dir = testing::TempDir() + "/eval_report_stripe";
+  ASSERT_EQ(std::system(("mkdir -p " + dir).c_str()), 0);
+  EvalMetrics m = half_upright();
+  m.stripes = 2;
+  m.stripes_within = 1;
+  m.stripe_error_mm[0] = {4.0, 16.0};
+  m.stripe_error_mm[1] = {-3.0, 2.0};
+  write_report(dir, m, "test", 0);
+  EXPECT_FALSE(cv::imread(dir + "/figure14_stripe_end.png").empty());
+  std::ifstream md(dir + "/report.md");
+  std::stringstream ss;
+  ss << md.rdbuf();
+  EXPECT_NE(ss.str().find("| stripe end PS within 15 mm X and 10 mm Y of the truth | 50.0 % (1/2)"), std::string::npos)
+      << ss.str();
+  EXPECT_NE(ss.str().find("| stripe end error X / Y mean, min / max | 10.0 (4.0 / 16.0) / -0.5 (-3.0 / 2.0) mm"),
+            std::string::npos)
+      << ss.str();
+  EXPECT_NE(ss.str().find("![stripe end](figure14_stripe_end.png)"), std::string::npos);
+}

@@ -263,3 +263,27 @@ TEST(FullCycleMetrics, JsonCarriesTheRequiredKeys) {
         "\"holder_standing_rate\": 1"})
     EXPECT_NE(j.find(key), std::string::npos) << key << " missing in\n" << j;
 }
+
+TEST(FullCycleMetrics, StripeEndsAreComparedInXAndYWithThePapersTolerances) {
+  // PS - true end per converged stripe servo, signed, in mm; within = |X| <= 15 mm and |Y| <= 10 mm (paper Fig. 14).
+  // PS's Z is the servo's standoff (0.46 m in front of the board here), not compared.
+  SceneOutcome o = done_scene(6);
+  const Eigen::Vector3d end(0.30, 0.12, 0.40);
+  o.result.stripes = {{0, end + Eigen::Vector3d(0.004, -0.003, -0.46), end},   // within
+                      {0, end + Eigen::Vector3d(0.016, 0.000, -0.46), end},    // X out (16 > 15)
+                      {1, end + Eigen::Vector3d(-0.002, 0.011, -0.46), end}};  // Y out (11 > 10)
+  EvalMetrics m;
+  accumulate(o, 0, MetricTolerances{}, &m);
+  EXPECT_EQ(m.stripes, 3);
+  EXPECT_EQ(m.stripes_within, 1);
+  ASSERT_EQ(m.stripe_error_mm[0].size(), 3u);
+  EXPECT_NEAR(m.stripe_error_mm[0][0], 4.0, 1e-9);
+  EXPECT_NEAR(m.stripe_error_mm[1][0], -3.0, 1e-9);
+  EXPECT_NEAR(m.stripe_error_mm[0][1], 16.0, 1e-9);
+  EXPECT_NEAR(m.stripe_error_mm[1][2], 11.0, 1e-9);
+  const std::string j = metrics_json(m, "cmd");
+  EXPECT_NE(j.find("\"stripes_measured\": 3"), std::string::npos) << j;
+  EXPECT_NE(j.find("\"stripe_within_tolerance_rate\": 0.333333"), std::string::npos) << j;
+  EXPECT_NE(j.find("\"stripe_error_mm\": {\"x\": {\"min\": -2, \"n\": 3"), std::string::npos) << j;
+  EXPECT_NE(j.find("\"y\": {\"min\": -3, \"n\": 3, \"mean\": 2.66667"), std::string::npos) << j;
+}

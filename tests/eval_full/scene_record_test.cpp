@@ -144,6 +144,25 @@ TEST(SceneRecord, UprightCountsRoundTripAndARecordFromBeforeThemReadsAsNoneCheck
   EXPECT_EQ(before.metrics.books_moved, r.metrics.books_moved);
 }
 
+TEST(SceneRecord, StripeEndsRoundTripAndARecordFromBeforeThemReadsAsNone) {
+  SceneOutcome o = other_scene(16);
+  const Eigen::Vector3d end(0.30, 0.12, 0.40);
+  o.result.stripes = {{0, end + Eigen::Vector3d(1.0 / 3.0e3, -0.003, -0.46), end}};
+  const SceneRecord r = record_of(o);
+  const SceneRecord back = parse_scene_record(scene_record_yaml(r), "test");
+  EXPECT_EQ(back.metrics.stripes, 1);
+  EXPECT_EQ(back.metrics.stripes_within, 1);
+  EXPECT_EQ(back.metrics.stripe_error_mm[0], r.metrics.stripe_error_mm[0]);  // bit for bit
+  EXPECT_EQ(back.metrics.stripe_error_mm[1], r.metrics.stripe_error_mm[1]);
+  // A stop 40 record (no stripe* keys): read, no stripe measured.
+  const std::string old_text = without_keys(scene_record_yaml(r), "stripe");
+  ASSERT_NE(old_text, scene_record_yaml(r));
+  const SceneRecord before = parse_scene_record(old_text, "stop40/scenes/seed_16.yaml");
+  EXPECT_EQ(before.metrics.stripes, 0);
+  EXPECT_TRUE(before.metrics.stripe_error_mm[0].empty());
+  EXPECT_EQ(before.metrics.width_error_mm, r.metrics.width_error_mm);
+}
+
 TEST(SceneRecord, ABadFileIsNamedWithItsKey) {
   std::string text = scene_record_yaml(record_of(done_scene(1)));
   const auto at = text.find("grasp_attempts:");
