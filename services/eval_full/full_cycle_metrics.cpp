@@ -135,6 +135,16 @@ std::string failure_reason(const FullCycleResult& r, int max_books) {
   return "";
 }
 
+int disagreement_mode(const GraspDecisionRecord& d, const MetricTolerances& tol) {
+  if (!d.p1_present || !d.truth_known) return -1;
+  const Eigen::Vector3d p2_p1 = d.p2_grasp - d.p1_grasp, p1_err = d.p1_grasp - d.p1_true_grasp;
+  if (std::abs(p2_p1.y()) <= tol.agreement_y_m && std::abs(p2_p1.x()) <= tol.agreement_x_m) return -1;
+  if (std::abs(p1_err.y()) > tol.agreement_y_m) return 0;
+  if (p1_err.x() > tol.agreement_x_m) return 1;
+  if (p1_err.x() < -tol.agreement_x_m) return 2;
+  return 3;
+}
+
 void accumulate(const SceneOutcome& o, int max_books, const MetricTolerances& tol, EvalMetrics* m) {
   const FullCycleResult& r = o.result;
   ++m->scenes;
@@ -177,6 +187,7 @@ void accumulate(const SceneOutcome& o, int max_books, const MetricTolerances& to
     m->p1_p2_dy_mm.push_back(dy * 1e3);
     m->p1_p2_dx_mm.push_back(dx * 1e3);
     if (std::abs(dy) <= tol.agreement_y_m && std::abs(dx) <= tol.agreement_x_m) ++m->decisions_agreeing;
+    if (const int mode = disagreement_mode(d, tol); mode >= 0) ++m->p1_p2_disagreements[mode];
     if (d.truth_known)
       for (int k = 0; k < 3; ++k) m->p1_error_mm[k].push_back(std::abs(d.p1_grasp[k] - d.p1_true_grasp[k]) * 1e3);
   }
@@ -269,6 +280,10 @@ std::string metrics_json(const EvalMetrics& m, const std::string& command) {
   j << "  \"books_upright_rate\": " << rate(m.books_upright_on_lower_shelf, m.books_upright_checked) << ",\n";
   j << "  \"p1_p2_decisions\": " << m.decisions << ",\n";
   j << "  \"p1_p2_agreement_rate\": " << rate(m.decisions_agreeing, m.decisions) << ",\n";
+  j << "  \"p1_p2_disagreement_modes\": {";
+  for (int k = 0; k < 4; ++k)
+    j << (k ? ", " : "") << "\"" << kDisagreementModes[k] << "\": " << m.p1_p2_disagreements[k];
+  j << "},\n";
   j << "  \"widths_measured\": " << m.widths << ",\n";
   j << "  \"width_within_1cm_rate\": " << rate(m.widths_within, m.widths) << ",\n";
   j << "  \"width_error_mm\": " << stats_json(stats_of(m.width_error_mm)) << ",\n";

@@ -39,6 +39,16 @@ Stats stats_of(std::vector<double> v);
 /// The outcomes of a close (PlateClose::outcome), in the order of EvalMetrics::plates_over_fore_edge_mm.
 inline constexpr const char* kCloseOutcomes[4] = {"held_alone", "double_lift", "not_held", "backed_out"};
 
+/// Why a P1 and its P2 disagreed (kDisagreementModes[k], by P1 against the true corner in the P1-P2 tolerances): P1
+/// more than agreement_y_m off in Y (another book's column), more than agreement_x_m above the corner (a taller
+/// neighbour's cover), more than agreement_x_m below it (the front's top missed), or P1 within both and P2 off.
+inline constexpr const char* kDisagreementModes[4] = {"p1_off_in_y", "p1_above_corner", "p1_below_corner",
+                                                      "p2_off_p1_near_corner"};
+
+/// The index into kDisagreementModes of a decision whose P1 and P2 disagree; -1 when they agree, or P1 or the truth
+/// is missing.
+int disagreement_mode(const GraspDecisionRecord& d, const MetricTolerances& tol);
+
 /// Everything metrics.json carries. A new field must also be listed in scene_record.cpp (counts() or samples()), or
 /// resumed and merged runs lose it.
 struct EvalMetrics {
@@ -73,6 +83,7 @@ struct EvalMetrics {
   /// gp_error_mm (GP in the arbiter's own cart frame) does not show when the cart frame itself is off.
   std::vector<double> gp_base_error_mm[3];
   std::vector<double> p1_p2_dy_mm, p1_p2_dx_mm;  ///< P2 - P1 per decision
+  int p1_p2_disagreements[4] = {0, 0, 0, 0};     ///< disagreeing decisions by kDisagreementModes
   int stripes = 0;                               ///< converged stripe servos (StripeRecord)
   int stripes_within = 0;  ///< ... with PS within MetricTolerances::stripe_x_m / stripe_y_m of the true end
   std::vector<double> stripe_error_mm[2];  ///< PS - true stripe end (signed) per grasp-frame axis X, Y

@@ -36,6 +36,10 @@ auto counts(M& m) {
       {"decisions_agreeing", &m.decisions_agreeing},
       {"widths", &m.widths},
       {"widths_within", &m.widths_within},
+      {"p1_p2_disagree_p1_off_in_y", &m.p1_p2_disagreements[0]},
+      {"p1_p2_disagree_p1_above_corner", &m.p1_p2_disagreements[1]},
+      {"p1_p2_disagree_p1_below_corner", &m.p1_p2_disagreements[2]},
+      {"p1_p2_disagree_p2_off_p1_near_corner", &m.p1_p2_disagreements[3]},
       {"stripes", &m.stripes},
       {"stripes_within", &m.stripes_within},
   };
@@ -70,10 +74,10 @@ auto samples(M& m) {
 }
 
 /// Keys added after the first scene records (stop 28: the plate samples; stop 31: the upright counts; stop 41: the
-/// stripe end): a record without them measured none (empty, 0).
+/// stripe end and the P1-P2 disagreements by mode): a record without them measured none (empty, 0).
 bool added_later(const std::string& key) {
   return key.rfind("plates_over_fore_edge_mm_", 0) == 0 || key.rfind("books_upright_", 0) == 0 ||
-         key.rfind("stripe", 0) == 0;
+         key.rfind("stripe", 0) == 0 || key.rfind("p1_p2_disagree_", 0) == 0;
 }
 
 std::string exact(double v) {

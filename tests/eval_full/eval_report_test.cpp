@@ -84,3 +84,19 @@ TEST(EvalReport, TheStripeEndHasItsFigureAndRow) {
       << ss.str();
   EXPECT_NE(ss.str().find("![stripe end](figure14_stripe_end.png)"), std::string::npos);
 }
+
+TEST(EvalReport, TheDisagreementsAreCountedByMode) {
+  const std::string dir = testing::TempDir() + "/eval_report_disagree";
+  ASSERT_EQ(std::system(("mkdir -p " + dir).c_str()), 0);
+  EvalMetrics m = half_upright();
+  m.decisions = 10;
+  m.decisions_agreeing = 4;
+  m.p1_p2_disagreements[0] = 1;
+  m.p1_p2_disagreements[1] = 2;
+  m.p1_p2_disagreements[2] = 3;
+  write_report(dir, m, "test", 0);
+  std::ifstream md(dir + "/report.md");
+  std::stringstream ss;
+  ss << md.rdbuf();
+  EXPECT_NE(ss.str().find("P2 off (P1 near the corner) | 1 / 2 / 3 / 0 |"), std::string::npos) << ss.str();
+}

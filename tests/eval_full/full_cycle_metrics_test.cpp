@@ -287,3 +287,46 @@ TEST(FullCycleMetrics, StripeEndsAreComparedInXAndYWithThePapersTolerances) {
   EXPECT_NE(j.find("\"stripe_error_mm\": {\"x\": {\"min\": -2, \"n\": 3"), std::string::npos) << j;
   EXPECT_NE(j.find("\"y\": {\"min\": -3, \"n\": 3, \"mean\": 2.66667"), std::string::npos) << j;
 }
+
+TEST(FullCycleMetrics, DisagreementsAreNamedByWhereP1LayAgainstTheTrueCorner) {
+  // Tolerances 15 mm Y, 20 mm X. The true corner at (300, 100, 0) mm; P2 on it unless said.
+  const Eigen::Vector3d corner(0.300, 0.100, 0.0);
+  auto decision = [&](const Eigen::Vector3d& p1, const Eigen::Vector3d& p2) {
+    GraspDecisionRecord d;
+    d.p1_present = true;
+    d.truth_known = true;
+    d.p1_true_grasp = corner;
+    d.p1_grasp = p1;
+    d.p2_grasp = p2;
+    d.gp_grasp = p2;
+    return d;
+  };
+  const MetricTolerances tol;
+  EXPECT_EQ(disagreement_mode(decision(corner + Eigen::Vector3d(0.019, 0.014, 0), corner), tol), -1);  // agree
+  EXPECT_EQ(disagreement_mode(decision(corner + Eigen::Vector3d(0.0, -0.030, 0), corner), tol), 0);    // Y
+  EXPECT_EQ(disagreement_mode(decision(corner + Eigen::Vector3d(0.055, -0.005, 0), corner), tol), 1);  // climb
+  EXPECT_EQ(disagreement_mode(decision(corner + Eigen::Vector3d(-0.075, 0.0, 0), corner), tol), 2);    // too low
+  // P1 10 mm above the corner, P2 25 mm below it: P1 is near, P2 is off.
+  EXPECT_EQ(
+      disagreement_mode(decision(corner + Eigen::Vector3d(0.010, 0, 0), corner + Eigen::Vector3d(-0.025, 0, 0)), tol),
+      3);
+  GraspDecisionRecord no_truth = decision(corner + Eigen::Vector3d(0.055, 0, 0), corner);
+  no_truth.truth_known = false;
+  EXPECT_EQ(disagreement_mode(no_truth, tol), -1);
+
+  SceneOutcome o = done_scene(8);
+  o.result.decisions = {decision(corner + Eigen::Vector3d(0.055, -0.005, 0), corner),
+                        decision(corner + Eigen::Vector3d(0.060, 0.0, 0), corner),
+                        decision(corner + Eigen::Vector3d(-0.075, 0.0, 0), corner), decision(corner, corner)};
+  EvalMetrics m;
+  accumulate(o, 0, tol, &m);
+  EXPECT_EQ(m.decisions, 4);
+  EXPECT_EQ(m.decisions_agreeing, 1);
+  EXPECT_EQ(m.p1_p2_disagreements[0], 0);
+  EXPECT_EQ(m.p1_p2_disagreements[1], 2);
+  EXPECT_EQ(m.p1_p2_disagreements[2], 1);
+  EXPECT_EQ(m.p1_p2_disagreements[3], 0);
+  EXPECT_NE(metrics_json(m, "c").find("\"p1_p2_disagreement_modes\": {\"p1_off_in_y\": 0, \"p1_above_corner\": 2, "
+                                      "\"p1_below_corner\": 1, \"p2_off_p1_near_corner\": 0}"),
+            std::string::npos);
+}

@@ -144,7 +144,7 @@ TEST(SceneRecord, UprightCountsRoundTripAndARecordFromBeforeThemReadsAsNoneCheck
   EXPECT_EQ(before.metrics.books_moved, r.metrics.books_moved);
 }
 
-TEST(SceneRecord, StripeEndsRoundTripAndARecordFromBeforeThemReadsAsNone) {
+TEST(SceneRecord, StripeEndsAndDisagreementsRoundTripAndARecordFromBeforeThemReadsAsNone) {
   SceneOutcome o = other_scene(16);
   const Eigen::Vector3d end(0.30, 0.12, 0.40);
   o.result.stripes = {{0, end + Eigen::Vector3d(1.0 / 3.0e3, -0.003, -0.46), end}};
@@ -154,12 +154,14 @@ TEST(SceneRecord, StripeEndsRoundTripAndARecordFromBeforeThemReadsAsNone) {
   EXPECT_EQ(back.metrics.stripes_within, 1);
   EXPECT_EQ(back.metrics.stripe_error_mm[0], r.metrics.stripe_error_mm[0]);  // bit for bit
   EXPECT_EQ(back.metrics.stripe_error_mm[1], r.metrics.stripe_error_mm[1]);
-  // A stop 40 record (no stripe* keys): read, no stripe measured.
-  const std::string old_text = without_keys(scene_record_yaml(r), "stripe");
+  for (int k = 0; k < 4; ++k) EXPECT_EQ(back.metrics.p1_p2_disagreements[k], r.metrics.p1_p2_disagreements[k]);
+  // A stop 40 record (no stripe* or p1_p2_disagree_* keys): read, none measured.
+  const std::string old_text = without_keys(without_keys(scene_record_yaml(r), "stripe"), "p1_p2_disagree_");
   ASSERT_NE(old_text, scene_record_yaml(r));
   const SceneRecord before = parse_scene_record(old_text, "stop40/scenes/seed_16.yaml");
   EXPECT_EQ(before.metrics.stripes, 0);
   EXPECT_TRUE(before.metrics.stripe_error_mm[0].empty());
+  for (int k = 0; k < 4; ++k) EXPECT_EQ(before.metrics.p1_p2_disagreements[k], 0);
   EXPECT_EQ(before.metrics.width_error_mm, r.metrics.width_error_mm);
 }
 
