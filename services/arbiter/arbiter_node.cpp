@@ -119,7 +119,6 @@ ArbiterSettings ArbiterSettings::from_config(const Config& root) {
   s.width_abandon_within = root.get_double("book_width.abandoned_within_m", 0.001, 0.5);
   s.p1_arm_still_s = root.get_double("p1.arm_still_s", 0.0, 60.0);
   s.p1_arm_still_joint_speed = root.get_double("p1.arm_still_joint_speed_rad_s", 0.0001, 10.0);
-  s.p1_frames = root.get_int("p1.frames", 1, 50);
   return s;
 }
 
@@ -128,10 +127,7 @@ ArbiterNode::ArbiterNode(const Config& root)
                   ArbiterSettings::from_config(root)) {}
 
 ArbiterNode::ArbiterNode(const std::string& service, const std::string& implementation, ArbiterSettings settings)
-    : Component(service, implementation),
-      s_(std::move(settings)),
-      follow_(s_.follow_implementation),
-      p1_frames_(s_.p1_frames) {
+    : Component(service, implementation), s_(std::move(settings)), follow_(s_.follow_implementation) {
   subscribe(s_.channels.book_corner_stereo, &ArbiterNode::on_book_corner);
   subscribe(s_.channels.servo_status, &ArbiterNode::on_servo_status);
   subscribe(s_.channels.servo_request, &ArbiterNode::on_servo_request);
@@ -186,7 +182,6 @@ void ArbiterNode::on_switch(const detector_switch_t& msg) {
     latest_p1_.reset();
     have_p1_msg_ = false;
   }
-  p1_frames_.clear();
   // Visible in SERVICE_STATUS.last_error (the runtime has no other free-text field).
   report_error("detector switch: now following " + s_.follow_logical_channel + " implementation '" + follow_ +
                "', " + switch_note_);
@@ -201,16 +196,14 @@ void ArbiterNode::on_book_corner(const book_corner_stereo_t& msg) {
   if (s_.p1_arm_still_s > 0 && last_arm_motion_utime_ &&
       double(msg.utime - *last_arm_motion_utime_) < s_.p1_arm_still_s * 1e6) {
     ++p1_skipped_arm_moving_;  // the arm moved at or just before this frame: it may be in the view
-    p1_frames_.clear();        // and what is in view may have changed (a grasp moves books)
     return;
   }
-  latest_regions_ = msg.regions;
-  p1_frames_.add(msg.found
-                     ? std::optional<Eigen::Vector3d>(Eigen::Vector3d(msg.p1_base[0], msg.p1_base[1], msg.p1_base[2]))
-                     : std::nullopt);
-  if (!p1_frames_.full()) return;  // latest_p1_ stays the last full window's until this one is
   have_p1_msg_ = true;
-  latest_p1_ = p1_frames_.p1();
+  latest_regions_ = msg.regions;
+  if (msg.found)
+    latest_p1_ = Eigen::Vector3d(msg.p1_base[0], msg.p1_base[1], msg.p1_base[2]);
+  else
+    latest_p1_.reset();
   if (!frozen_) publish_p1_check(msg.utime, 0);
 }
 

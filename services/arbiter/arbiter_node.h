@@ -17,10 +17,7 @@
 ///   the arm had been still for `p1.arm_still_s` count (ARM_STATE not EXECUTING
 ///   and no joint faster than `p1.arm_still_joint_speed`): a frame taken while
 ///   the arm moves in front of the shelf shows the arm, not the books; such a
-///   frame neither replaces the latest P1 nor makes a P1 check, and it clears
-///   the still frames collected so far. Not in the paper: the latest P1 is the
-///   per-axis median of the last `p1.frames` still frames' P1s (p1_frames.h;
-///   none when no more than half found one), and a P1 check waits for them.
+///   frame neither replaces the latest P1 nor makes a P1 check.
 /// - GRASP_POINT.reason starts with the outcome word:
 ///   `P1_VALID` / `P1_INVALID` (P1 check: on every followed BOOK_CORNER_STEREO
 ///   while P1 is not frozen and PS is known, and when a STRIPE_END servo
@@ -50,7 +47,6 @@
 #include "common/component.h"
 #include "common/config.h"
 #include "services/arbiter/combination_strategy.h"
-#include "services/arbiter/p1_frames.h"
 #include "services/arbiter/stereo_front_depth.h"
 
 namespace bookgrasp {
@@ -86,9 +82,6 @@ struct ArbiterSettings {
   double p1_arm_still_s = 0.5;          ///< a P1 counts only from a frame taken this long after the arm last moved
                                         ///< (0 = every frame)
   double p1_arm_still_joint_speed = 0.01;  ///< rad/s: a joint faster than this means the arm moves
-  /// Not in the paper: P1 is the per-axis median of this many still frames' P1s (p1_frames.h), and a P1 check waits
-  /// for them; 1 = every still frame's own P1, the paper's.
-  int p1_frames = 1;
 
   /// Reads and validates every key; throws ConfigError naming a bad one.
   static ArbiterSettings from_config(const Config& root);
@@ -133,7 +126,6 @@ class ArbiterNode : public Component {
   std::string switch_note_;                    ///< last switch, for GRASP_POINT.reason
   std::optional<Eigen::Isometry3d> frame_;     ///< grasp frame in base (from the cart marker)
   std::optional<Eigen::Vector3d> latest_p1_;   ///< base; empty when BwS found nothing
-  P1Frames p1_frames_;                         ///< the still frames' P1s latest_p1_ is the median of
   bool have_p1_msg_ = false;                   ///< a followed BOOK_CORNER_STEREO arrived
   std::optional<Eigen::Vector3d> frozen_p1_;   ///< P1 of the attempt (base)
   std::vector<plane_region_t> latest_regions_;  ///< the followed BwS frame's regions (base)

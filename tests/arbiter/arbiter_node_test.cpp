@@ -321,36 +321,6 @@ TEST_F(ArbiterNodeTest, P1FromAFrameTakenWhileTheArmMovedIsNotUsed) {
   EXPECT_EQ(node->p1_skipped_arm_moving(), 2);
 }
 
-// With p1.frames 3, P1 is the per-axis median of three still frames and the P1 check waits for the third: a frame
-// whose P1 climbed 55 mm onto a taller neighbour does not decide (base z is the grasp frame's X, the height).
-TEST(ArbiterP1Frames, ThePerAxisMedianOfThreeStillFramesIsP1) {
-  std::string text = arbiter_config().dump();
-  const auto pos = text.find("frames: 1");
-  ASSERT_NE(pos, std::string::npos);
-  text.replace(pos, 9, "frames: 3");
-  Composition comp;
-  comp.add(std::make_unique<ArbiterNode>(Config::from_string(text, "arbiter.yaml")));
-  Collector<grasp_point_t> out;
-  comp.bus().subscribe("GRASP_POINT", &Collector<grasp_point_t>::on, &out);
-  const auto send = [&](const std::string& channel, const auto& m) {
-    comp.bus().publish(channel, &m);
-    comp.spin();
-  };
-  send("MARKERS", markers(1000));
-  send("BOOK_CORNER_STEREO", corner(500000, "god", true, {0.61, -0.30, 0.305}));  // climbed
-  send("BOOK_CORNER_STEREO", corner(1000000, "god", true, {0.61, -0.301, 0.251}));
-  EXPECT_TRUE(out.got.empty()) << "no P1 check before the third frame";
-  send("BOOK_CORNER_STEREO", corner(1500000, "god", true, {0.61, -0.299, 0.249}));
-  ASSERT_EQ(out.got.size(), 1u);
-  EXPECT_TRUE(starts_with(out.got[0].reason, "NEED_PS")) << out.got[0].reason;
-  send("SERVO_REQUEST", request(2000000, 1, servo_request_t::STRIPE_END));
-  send("SERVO_STATUS",
-       status(4000000, 1, servo_request_t::STRIPE_END, servo_status_t::CONVERGED, {0.45, -0.305, 0.10}));
-  ASSERT_EQ(out.got.size(), 2u);
-  EXPECT_TRUE(starts_with(out.got[1].reason, "P1_VALID")) << out.got[1].reason;
-  expect_vec(out.got[1].p1_grasp, {0.251, 0.25, 0.01}, "the median of the three frames' P1s");
-}
-
 // Plates that open again where they closed gave the grasp up (the coordinator's plate-distance check backs out of two
 // books): PS goes back to what it was before that BW moved it (the deployed seed 1 took the next book otherwise).
 TEST_F(ArbiterNodeTest, PlatesOpenedWhereTheyClosedRestorePs) {
@@ -811,8 +781,7 @@ TEST(ArbiterConfig, BadDepthKeysNameTheKey) {
            {"tolerances.raise_over_neighbour_corner", "raise_over_neighbour_corner: true",
             "raise_over_neighbour_corner: yes please"},
            {"tolerances.start_from_p1_right_of_measured_ps", "start_from_p1_right_of_measured_ps: true",
-            "start_from_p1_right_of_measured_ps: 3"},
-           {"p1.frames", "frames: 1 ", "frames: 0 "}}) {
+            "start_from_p1_right_of_measured_ps: 3"}}) {
     std::string text = shipped;
     const auto pos = text.find(line);
     ASSERT_NE(pos, std::string::npos) << line;
