@@ -192,8 +192,13 @@ CombinationResult combine(const CombinationInputs& in, const CombinationToleranc
   const double dy = p2.y() - ref.y();
   // Not in the paper: P2 left of a valid P1 beyond the Y tolerance *and* above it beyond the X
   // tolerance is a taller left neighbour's corner (each alone the paper accepts). P1, confirmed by
-  // PS, is the right-most book's corner: grasp there.
-  if (r.p1_valid && tol.p1_over_other_book) {
+  // PS, is the right-most book's corner: grasp there. Not when the rule below (P2 far left of a measured PS) will
+  // answer: P1 is confirmed by PS in Y only, and BwS's P1 can lie far up that neighbour's front (its "neighbour
+  // climb", docs/BWS.md); GP = P1 then closed the plates above the book (far_cart seed 5125: P1 and GP 55 mm above
+  // the corner, P2 22 mm left of PS). BwH from PS, the next attempt, finds the book's own corner.
+  const bool p2_far_left_of_measured_ps =
+      in.ps_measured && tol.p2_ps_y > 0 && p2.y() - in.ps.y() < -tol.p2_ps_y && !bwh_started_from_p1_right_of_ps(r);
+  if (r.p1_valid && tol.p1_over_other_book && !p2_far_left_of_measured_ps) {
     const double dx = p2.x() - in.p1->x();
     if (dy <= -tol.y && dx >= tol.x) {
       r.steps.push_back(step(
@@ -208,8 +213,7 @@ CombinationResult combine(const CombinationInputs& in, const CombinationToleranc
   // Not in the paper: a measured PS is the right-most book's right edge within a few mm, so a P2 far left of it is a
   // left neighbour's corner. With a valid P1 it is the book P1 lay on, a taller neighbour of a thin right-most book
   // (P1_LED_ASTRAY: BwH from PS next). Without one, BwH from PS at the stripe's height centred a shorter neighbour's
-  // corner, the tall right-most book's lying above the view (RAISE_BWH_START: BwH from higher next; once raised, no
-  // grasp). After the rule above: a P2 left of and above a P1 on the right book keeps GP = P1. Not when BwH started
+  // grasp). It answers before the rule above when both apply. Not when BwH started
   // from an invalid P1 right of the measured PS: that PS is taken as off (far_cart seed 5498: the stripe end 202 mm
   // left of a book leaning on the side panel; raising from there sent BwH above every book).
   if (in.ps_measured && tol.p2_ps_y > 0 && (r.p1_valid || tol.raised_bwh_start_x > 0)) {

@@ -169,6 +169,43 @@ TEST(CombinationStrategy, TheLeftNeighbourRuleCanBeSwitchedOffForThePapersRules)
   EXPECT_NEAR(ours.steps[ours.steps.size() - 2].value, -0.02, 1e-12);
 }
 
+TEST(CombinationStrategy, AP2LeftAndAboveAP1FarLeftOfAMeasuredPsIsLedAstrayNotGpAtP1) {
+  // Far_cart seed 5009 (grasp frame, m): the right-most corner at (0.1831, 0.2846); the stripe servo measured PS 0.3 mm
+  // right of it; BwS's P1 climbed 56.8 mm up the taller left neighbour's front (valid: 7.8 mm left of the corner,
+  // within 10 mm of PS); BwH from P1 centred the neighbour's corner 42.4 mm above and 17.6 mm left of P1, 25.7 mm left
+  // of PS. GP = P1 closed the plates 57 mm above the book.
+  CombinationTolerances tol = kTol;
+  tol.p2_ps_y = 0.010;
+  CombinationInputs in;
+  in.ps = V(0.10, 0.2849, 0.50);
+  in.ps_measured = true;
+  in.p1 = V(0.2399, 0.2768, 0.40);
+  in.p2 = V(0.2823, 0.2592, 0.45);
+  const CombinationResult r = combine(in, tol);
+  EXPECT_TRUE(r.p1_valid);
+  EXPECT_EQ(outcome_name(r.outcome), "P1_LED_ASTRAY");
+  ASSERT_FALSE(r.steps.empty());
+  EXPECT_EQ(r.steps.back().rule, "P2.y vs measured PS.y");
+  EXPECT_NEAR(r.steps.back().value, -0.0257, 1e-12);
+  // A PS estimated from the last grasp (GP.y - BW) does not say where the book's edge is: GP = P1 as before. So with
+  // the PS rule off.
+  for (const bool measured : {false, true}) {
+    CombinationInputs e = in;
+    e.ps_measured = measured;
+    CombinationTolerances t = tol;
+    if (measured) t.p2_ps_y = 0.0;
+    const CombinationResult g = combine(e, t);
+    EXPECT_EQ(outcome_name(g.outcome), "GRASP") << measured;
+    EXPECT_TRUE(g.gp.isApprox(*in.p1, 1e-12)) << measured << ": " << g.gp.transpose();
+  }
+  // P2 left of and above P1 but within 10 mm of the measured PS: the left-neighbour rule still answers, GP = P1.
+  in.p2 = V(0.2823, 0.2759, 0.45);  // 9.0 mm left of PS, 0.9 mm left of P1: not beyond the Y tolerance
+  in.p1 = V(0.2399, 0.2910, 0.40);  // 6.1 mm right of PS (valid), so P2 is 15.1 mm left of P1
+  const CombinationResult k = combine(in, tol);
+  EXPECT_EQ(outcome_name(k.outcome), "GRASP");
+  EXPECT_TRUE(k.gp.isApprox(*in.p1, 1e-12)) << k.gp.transpose();
+}
+
 /// PS, a P2 5 mm left of it and the model's front plane at Z 0.42, for the rules that give GP.z without a valid P1;
 /// with `tol` ranging 0.15 around that plane (arbiter.yaml tolerances.invalid_p1_depth_range_m).
 CombinationInputs depth_case(CombinationTolerances* tol) {
@@ -343,14 +380,13 @@ TEST(CombinationStrategy, AP2FarLeftOfAMeasuredPsIsTheNeighbourP1LedBwhTo) {
     EXPECT_EQ(g.outcome, GraspOutcome::kGrasp) << measured;
     EXPECT_TRUE(g.gp.isApprox(V(0.21, 0.085, 0.40), 1e-12)) << measured;
   }
-  // P2 left of AND above a P1 at the stripe end: a taller neighbour's corner beside the right book, GP = P1 (the
-  // left-neighbour rule comes first; nothing to re-route).
+  // P2 left of AND above a P1 at the stripe end, 20 mm left of the measured PS: a taller neighbour's corner. Until stop
+  // 41 the left-neighbour rule answered first with GP = P1; but P1 may have climbed that neighbour's front (seeds 5125,
+  // 5009), so this rule answers first now: BwH from PS next.
   CombinationInputs taller = in;
   taller.p1 = V(0.20, 0.099, 0.40);
   taller.p2 = V(0.25, 0.080, 0.45);
-  const CombinationResult keep = combine(taller, tol);
-  EXPECT_EQ(keep.outcome, GraspOutcome::kGrasp);
-  EXPECT_TRUE(keep.gp.isApprox(V(0.20, 0.099, 0.40), 1e-12)) << keep.gp.transpose();
+  EXPECT_EQ(outcome_name(combine(taller, tol).outcome), "P1_LED_ASTRAY");
   // Without a valid P1 (BwH started from PS already) nothing led BwH astray: the paper's rule (P2 left of PS).
   CombinationInputs no_p1 = in;
   no_p1.p1.reset();
