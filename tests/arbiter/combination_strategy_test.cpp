@@ -169,6 +169,20 @@ TEST(CombinationStrategy, TheLeftNeighbourRuleCanBeSwitchedOffForThePapersRules)
   EXPECT_NEAR(ours.steps[ours.steps.size() - 2].value, -0.02, 1e-12);
 }
 
+/// `in` with its PS estimated (not measured), and with the measured-PS rule off (p2_ps_y 0): a GRASP at `gp`.
+void expect_grasp_without_the_measured_ps_rule(const CombinationInputs& in, const CombinationTolerances& tol,
+                                               const V& gp) {
+  for (const bool measured : {false, true}) {
+    CombinationInputs e = in;
+    e.ps_measured = measured;
+    CombinationTolerances t = tol;
+    if (measured) t.p2_ps_y = 0.0;
+    const CombinationResult g = combine(e, t);
+    EXPECT_EQ(outcome_name(g.outcome), "GRASP") << "PS measured " << measured;
+    EXPECT_TRUE(g.gp.isApprox(gp, 1e-12)) << "PS measured " << measured << ": " << g.gp.transpose();
+  }
+}
+
 TEST(CombinationStrategy, AP2LeftAndAboveAP1FarLeftOfAMeasuredPsIsLedAstrayNotGpAtP1) {
   // Far_cart seed 5009 (grasp frame, m): the right-most corner at (0.1831, 0.2846); the stripe servo measured PS 0.3 mm
   // right of it; BwS's P1 climbed 56.8 mm up the taller left neighbour's front (valid: 7.8 mm left of the corner,
@@ -189,15 +203,7 @@ TEST(CombinationStrategy, AP2LeftAndAboveAP1FarLeftOfAMeasuredPsIsLedAstrayNotGp
   EXPECT_NEAR(r.steps.back().value, -0.0257, 1e-12);
   // A PS estimated from the last grasp (GP.y - BW) does not say where the book's edge is: GP = P1 as before. So with
   // the PS rule off.
-  for (const bool measured : {false, true}) {
-    CombinationInputs e = in;
-    e.ps_measured = measured;
-    CombinationTolerances t = tol;
-    if (measured) t.p2_ps_y = 0.0;
-    const CombinationResult g = combine(e, t);
-    EXPECT_EQ(outcome_name(g.outcome), "GRASP") << measured;
-    EXPECT_TRUE(g.gp.isApprox(*in.p1, 1e-12)) << measured << ": " << g.gp.transpose();
-  }
+  expect_grasp_without_the_measured_ps_rule(in, tol, *in.p1);
   // P2 left of and above P1 but within 10 mm of the measured PS: the left-neighbour rule still answers, GP = P1.
   in.p2 = V(0.2823, 0.2759, 0.45);  // 9.0 mm left of PS, 0.9 mm left of P1: not beyond the Y tolerance
   in.p1 = V(0.2399, 0.2910, 0.40);  // 6.1 mm right of PS (valid), so P2 is 15.1 mm left of P1
@@ -371,15 +377,7 @@ TEST(CombinationStrategy, AP2FarLeftOfAMeasuredPsIsTheNeighbourP1LedBwhTo) {
   EXPECT_TRUE(combine(in, tol).gp.isApprox(V(0.21, 0.091, 0.40), 1e-12));
   in.p2 = V(0.21, 0.085, 0.45);
   // A PS estimated from the last grasp (GP.y - BW), or the rule off: the paper's rules accept the P2.
-  for (const bool measured : {false, true}) {
-    CombinationInputs e = in;
-    e.ps_measured = measured;
-    CombinationTolerances t = tol;
-    if (measured) t.p2_ps_y = 0.0;
-    const CombinationResult g = combine(e, t);
-    EXPECT_EQ(g.outcome, GraspOutcome::kGrasp) << measured;
-    EXPECT_TRUE(g.gp.isApprox(V(0.21, 0.085, 0.40), 1e-12)) << measured;
-  }
+  expect_grasp_without_the_measured_ps_rule(in, tol, V(0.21, 0.085, 0.40));
   // P2 left of AND above a P1 at the stripe end, 20 mm left of the measured PS: a taller neighbour's corner. Until stop
   // 41 the left-neighbour rule answered first with GP = P1; but P1 may have climbed that neighbour's front (seeds 5125,
   // 5009), so this rule answers first now: BwH from PS next.

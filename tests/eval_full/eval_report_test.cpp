@@ -32,6 +32,14 @@ cv::Vec3b pixel_in_upright_bar(const cv::Mat& img, int height_px) {
   return img.at<cv::Vec3b>(320 - height_px, 530);
 }
 
+/// DIR/report.md's text.
+std::string report_text(const std::string& dir) {
+  std::ifstream md(dir + "/report.md");
+  std::stringstream ss;
+  ss << md.rdbuf();
+  return ss.str();
+}
+
 }  // namespace
 
 TEST(EvalReport, TheRatesChartHasAnUprightBarOfTheUprightShare) {
@@ -46,10 +54,8 @@ TEST(EvalReport, TheRatesChartHasAnUprightBarOfTheUprightShare) {
   EXPECT_EQ(pixel_in_upright_bar(img, 10), blue);
   EXPECT_EQ(pixel_in_upright_bar(img, 130), blue);
   EXPECT_EQ(pixel_in_upright_bar(img, 160), white);
-  std::ifstream md(dir + "/report.md");
-  std::stringstream ss;
-  ss << md.rdbuf();
-  EXPECT_NE(ss.str().find("standing upright on the lower shelf"), std::string::npos);
+  const std::string report = report_text(dir);
+  EXPECT_NE(report.find("standing upright on the lower shelf"), std::string::npos);
 }
 
 TEST(EvalReport, NoUprightBarWhenNoSceneCheckedIt) {
@@ -74,15 +80,13 @@ TEST(EvalReport, TheStripeEndHasItsFigureAndRow) {
   m.stripe_error_mm[1] = {-3.0, 2.0};
   write_report(dir, m, "test", 0);
   EXPECT_FALSE(cv::imread(dir + "/figure14_stripe_end.png").empty());
-  std::ifstream md(dir + "/report.md");
-  std::stringstream ss;
-  ss << md.rdbuf();
-  EXPECT_NE(ss.str().find("| stripe end PS within 15 mm X and 10 mm Y of the truth | 50.0 % (1/2)"), std::string::npos)
-      << ss.str();
-  EXPECT_NE(ss.str().find("| stripe end error X / Y mean, min / max | 10.0 (4.0 / 16.0) / -0.5 (-3.0 / 2.0) mm"),
+  const std::string report = report_text(dir);
+  EXPECT_NE(report.find("| stripe end PS within 15 mm X and 10 mm Y of the truth | 50.0 % (1/2)"), std::string::npos)
+      << report;
+  EXPECT_NE(report.find("| stripe end error X / Y mean, min / max | 10.0 (4.0 / 16.0) / -0.5 (-3.0 / 2.0) mm"),
             std::string::npos)
-      << ss.str();
-  EXPECT_NE(ss.str().find("![stripe end](figure14_stripe_end.png)"), std::string::npos);
+      << report;
+  EXPECT_NE(report.find("![stripe end](figure14_stripe_end.png)"), std::string::npos);
 }
 
 TEST(EvalReport, TheDisagreementsAreCountedByMode) {
@@ -95,8 +99,6 @@ TEST(EvalReport, TheDisagreementsAreCountedByMode) {
   m.p1_p2_disagreements[1] = 2;
   m.p1_p2_disagreements[2] = 3;
   write_report(dir, m, "test", 0);
-  std::ifstream md(dir + "/report.md");
-  std::stringstream ss;
-  ss << md.rdbuf();
-  EXPECT_NE(ss.str().find("P2 off (P1 near the corner) | 1 / 2 / 3 / 0 |"), std::string::npos) << ss.str();
+  const std::string report = report_text(dir);
+  EXPECT_NE(report.find("P2 off (P1 near the corner) | 1 / 2 / 3 / 0 |"), std::string::npos) << report;
 }
