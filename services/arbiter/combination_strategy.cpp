@@ -213,7 +213,8 @@ CombinationResult combine(const CombinationInputs& in, const CombinationToleranc
   // Not in the paper: a measured PS is the right-most book's right edge within a few mm, so a P2 far left of it is a
   // left neighbour's corner. With a valid P1 it is the book P1 lay on, a taller neighbour of a thin right-most book
   // (P1_LED_ASTRAY: BwH from PS next). Without one, BwH from PS at the stripe's height centred a shorter neighbour's
-  // grasp). It answers before the rule above when both apply. Not when BwH started
+  // corner, the tall right-most book's lying above the view (RAISE_BWH_START: BwH from higher next; once raised, no
+  // grasp). It answers before the left-neighbour rule above when both apply. Not when BwH started
   // from an invalid P1 right of the measured PS: that PS is taken as off (far_cart seed 5498: the stripe end 202 mm
   // left of a book leaning on the side panel; raising from there sent BwH above every book).
   if (in.ps_measured && tol.p2_ps_y > 0 && (r.p1_valid || tol.raised_bwh_start_x > 0)) {

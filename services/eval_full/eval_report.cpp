@@ -144,7 +144,8 @@ void write_report(const std::string& dir, const EvalMetrics& m, const std::strin
   md << "| books left on the holder for the librarian: too tall for the lower shelf / not placeable there | "
      << m.books_handed_over - m.books_handed_over_unplaceable << " / " << m.books_handed_over_unplaceable << " | - |\n";
   md << "| P1-P2 agreement (|dY| <= 15 mm, |dX| <= 20 mm) | " << pct(m.decisions_agreeing, m.decisions) << " | 80 % |\n";
-  md << "| ... disagreeing: P1 off in Y (another book) / above the corner (X, a neighbour's cover) / below it / P2 off "
+  md << "| ... disagreeing: P1 off in Y (another book) / above the corner (X, on a taller neighbour) / below it / P2 "
+        "off "
         "(P1 near the corner) | "
      << m.p1_p2_disagreements[0] << " / " << m.p1_p2_disagreements[1] << " / " << m.p1_p2_disagreements[2] << " / "
      << m.p1_p2_disagreements[3] << " | - |\n";

@@ -40,8 +40,9 @@ Stats stats_of(std::vector<double> v);
 inline constexpr const char* kCloseOutcomes[4] = {"held_alone", "double_lift", "not_held", "backed_out"};
 
 /// Why a P1 and its P2 disagreed (kDisagreementModes[k], by P1 against the true corner in the P1-P2 tolerances): P1
-/// more than agreement_y_m off in Y (another book's column), more than agreement_x_m above the corner (a taller
-/// neighbour's cover), more than agreement_x_m below it (the front's top missed), or P1 within both and P2 off.
+/// more than agreement_y_m off in Y (another book's column), more than agreement_x_m above the corner (on a taller
+/// neighbour's cover or front), more than agreement_x_m below it (the front's top missed), or P1 within both and P2
+/// off.
 inline constexpr const char* kDisagreementModes[4] = {"p1_off_in_y", "p1_above_corner", "p1_below_corner",
                                                       "p2_off_p1_near_corner"};
 
