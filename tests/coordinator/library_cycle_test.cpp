@@ -714,8 +714,9 @@ TEST(LibraryCycle, ARestartedCoordinatorThatCannotSeeTheCartTagResumesWithItsPer
         bookgrasp::progress_from_yaml(bookgrasp::progress_to_yaml(first->progress()), "restart");
     EXPECT_TRUE(progress.cart_marker_in_base.has_value());
     EXPECT_TRUE(progress.holder_marker_in_base.has_value());
-    if (progress.cart_marker_in_base)
+    if (progress.cart_marker_in_base) {
       EXPECT_LT((progress.cart_marker_in_base->translation() - cart_marker_pose().translation()).norm(), 1e-9);
+    }
     if (!persisted) progress.cart_marker_in_base.reset();
     first.reset();
     w.cart_tag_hidden = true;
@@ -1479,7 +1480,7 @@ TEST(TaskProgress, TheMarkerPosesRoundTripAndAMalformedOneIsNamed) {
       "books_moved: 0\nfailures: 0\nplace: gripper_from_shelf\nhave_book_data: false\ngp_grasp: [0, 0, 0]\n"
       "book_width: 0\nlower_next_right_y: 0\nfinished: false\nlast_state: MOVE_TO_HOLDER\nmoved: []\n";
   EXPECT_FALSE(bookgrasp::progress_from_yaml(head, "old.yaml").cart_marker_in_base.has_value());
-  for (const std::string& bad : {"cart_marker_in_base: [1, 2, 3]\n", "cart_marker_in_base: [1, 2, 3, .nan, 0, 0, 0]\n",
+  for (const std::string bad : {"cart_marker_in_base: [1, 2, 3]\n", "cart_marker_in_base: [1, 2, 3, .nan, 0, 0, 0]\n",
                                  "holder_marker_in_base: [1, 2, 3, 2, 0, 0, 0]\n"}) {
     try {
       bookgrasp::progress_from_yaml(head + bad, "p.yaml");
