@@ -528,6 +528,19 @@ struct FullCycleHarness::Impl {
             std::to_string(b.truth_id) + fmt(" lowest corner %.3f m above the ledge,", lowest) +
             fmt(" up %.0f deg from the back plate's", std::acos(std::clamp(up, -1.0, 1.0)) * 180 / M_PI));
     }
+    if (target_book_id >= 0 && m->current_book >= 0 && m->current_book < static_cast<int>(res.books.size())) {
+      // Does the target still stand? Books fall by themselves in some scenes (a neighbour leaning onto the right-most
+      // one, a thin book creeping over): the failure is then named for that, not for what followed.
+      BookRecord& b = res.books[m->current_book];
+      const book_truth_t* tb = truth_book(now_truth, b.truth_id);
+      if (tb && b.truth_id == target_book_id && b.grasp_attempts == 0 && b.not_standing_s < 0 &&
+          tb->place == "upper_shelf" && height_axis_tilt_deg(tb->pose) > kStandingMaxTiltDeg) {
+        b.not_standing_s = rel_s(m->utime);
+        b.not_standing_tilt_deg = height_axis_tilt_deg(tb->pose);
+        trace("TRUTH RIGHT-MOST NOT STANDING: book id " + std::to_string(b.truth_id) +
+              fmt(" leans %.1f deg from upright", b.not_standing_tilt_deg) + " (entering " + m->state + ")");
+      }
+    }
     if (m->state == "CLOSE_GRIPPER") {
       BookRecord& b = book(m->current_book);
       ++b.grasp_attempts;

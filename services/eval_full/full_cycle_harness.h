@@ -78,6 +78,10 @@ struct StripeRecord {
   Eigen::Vector3d end_true_grasp = Eigen::Vector3d::Zero();  ///< the true stripe end, same frame, m
 };
 
+/// A book on the upper shelf tilted further than this from upright does not stand (the scenes lean books by at most
+/// 3 deg; a fallen book lies at 90, one leaning on the side panel at 15-50): the paper's grasp assumes standing books.
+inline constexpr double kStandingMaxTiltDeg = 10.0;
+
 /// One book taken (or tried) by the cycle.
 struct BookRecord {
   int index = 0;                     ///< order in the cycle (0 = first)
@@ -103,6 +107,11 @@ struct BookRecord {
   /// ledge (truth: lowest corner within 2 cm of the ledge, its up within 35 deg of the back plate's), 0 = it
   /// does not (fell over, lies on the base, ...), -1 = not reached.
   int standing_on_holder = -1;
+  /// Truth: the first TASK_STATUS change before this book's first close at which it leaned more than
+  /// kStandingMaxTiltDeg from upright on the upper shelf (fallen over, or leaning on the side panel), in message time
+  /// (s from start); -1 = it stood at every change up to its first close.
+  double not_standing_s = -1;
+  double not_standing_tilt_deg = 0;  ///< its tilt then, deg
   double start_s = 0;                ///< message time the book's attempt started (s from start)
   double end_s = -1;                 ///< message time it was counted moved
 };

@@ -67,6 +67,11 @@ int books_on_lower_shelf(const FullCycleResult& r) {
 std::string failure_reason(const FullCycleResult& r, int max_books) {
   if (r.end == "ERROR") return "ERROR: " + r.message;
   for (const auto& b : r.books)
+    if (b.not_standing_s >= 0 && b.grasp_successes == 0)
+      return "RIGHTMOST_NOT_STANDING before its first close: the right-most book leaned more than " +
+             std::to_string(static_cast<int>(kStandingMaxTiltDeg)) +
+             " deg (fallen, or leaning on the side panel); it was not grasped";
+  for (const auto& b : r.books)
     if (!b.carried_along.empty())
       return "DOUBLE_LIFT: a grasp took " + std::to_string(b.carried_along.size()) +
              " other book(s) out of the shelf with the target";

@@ -94,6 +94,8 @@ TEST(FullCycle, FirstBookToHolderAndLowerShelf) {
   EXPECT_GE(r.grasp_successes, 1);
   ASSERT_FALSE(r.books.empty());
   EXPECT_EQ(r.books[0].truth_id, first);
+  EXPECT_LT(r.books[0].not_standing_s, 0)
+      << "the first book stood until its close, leaning " << r.books[0].not_standing_tilt_deg << " deg";
   ASSERT_GE(r.books[0].measured_width_m, 0) << "the arbiter reported no book width";
   EXPECT_NEAR(r.books[0].measured_width_m, r.books[0].true_width_m, 0.01) << "book width from the plates";
   // The first book's PS is the stripe servo's (BSwH): within the paper's positioning tolerance of the true stripe end.
@@ -101,6 +103,27 @@ TEST(FullCycle, FirstBookToHolderAndLowerShelf) {
   const Eigen::Vector3d ps_error = r.stripes.front().ps_true_grasp - r.stripes.front().end_true_grasp;
   EXPECT_LE(std::abs(ps_error.x()), 0.015) << "PS - true stripe end in X (up), m";
   EXPECT_LE(std::abs(ps_error.y()), 0.010) << "PS - true stripe end in Y (right), m";
+}
+
+// Far_cart seed 5247: the right-most book's left neighbour leans onto it and both fall flat within the first second,
+// before the arm moves (sim_world alone, the arm at rest: 15 deg at 0.5 s, 90 at 1.0 s). The harness sees it from the
+// truth (BookRecord::not_standing_s), and failure_reason names the scene's failure for it (full_cycle_metrics_test).
+TEST(FullCycle, ARightMostBookThatFellBeforeTheGraspIsNamedSo) {
+  FullCycleOptions o = options("fallen_rightmost");
+  o.seed = 5247;
+  FullCycleHarness h(o);
+  const int first = rightmost_id(h.result().final_truth);
+  ASSERT_GE(first, 0);
+  const std::string end = h.run_until(kBookBudgetS, 0, [&] { return h.status().state == "CLOSE_GRIPPER"; });
+  ASSERT_EQ(end, "STOP") << describe(h.result());
+  const FullCycleResult r = h.result();
+  ASSERT_FALSE(r.books.empty());
+  EXPECT_EQ(r.books[0].truth_id, first);
+  EXPECT_GE(r.books[0].not_standing_s, 0) << describe(r);
+  EXPECT_GT(r.books[0].not_standing_tilt_deg, 60) << "it lies flat in the truth";
+  const book_truth_t* b = find_book(r.final_truth, first);
+  ASSERT_NE(b, nullptr);
+  EXPECT_EQ(b->place, "upper_shelf");
 }
 
 // The coordinator is destroyed with the book on the holder and rebuilt from its progress file: the new one

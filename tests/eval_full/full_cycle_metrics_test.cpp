@@ -195,6 +195,33 @@ TEST(FullCycleMetrics, FailureReasons) {
   EXPECT_EQ(failure_reason(r, 1), "ABORTED in MOVE_TO_HOLDER_PRE_GRASP: plan failed");
 }
 
+// Seed 5498's shape: the right-most book fell over before the first close, the cycle took another book and put it
+// on the holder. The failure is the fallen book, named before the holder's "not on it" that follows from it; a target
+// that fell and was grasped all the same is not this failure.
+TEST(FullCycleMetrics, ARightMostBookThatFellBeforeItsFirstCloseIsNamedFirst) {
+  FullCycleResult r;
+  r.end = "BOOKS";
+  r.final_truth.books = {truth_book("upper_shelf", 0), truth_book("other", 2)};
+  BookRecord fell;
+  fell.truth_id = 0;
+  fell.grasp_attempts = 1;
+  fell.place_after_holder_release = "upper_shelf";
+  fell.handed_over = true;
+  r.books = {fell};
+  r.grasp_attempts = 1;
+  const std::string not_on_holder =
+      "BOOK_NOT_ON_HOLDER after RELEASE_ON_HOLDER: the book is upper_shelf (it was not in the plates after EXTRACT)";
+  EXPECT_EQ(failure_reason(r, 1), not_on_holder) << "standing (not_standing_s < 0): the old name";
+  r.books[0].not_standing_s = 7.0;
+  r.books[0].not_standing_tilt_deg = 49.6;
+  EXPECT_EQ(failure_reason(r, 1),
+            "RIGHTMOST_NOT_STANDING before its first close: the right-most book leaned more than 10 deg (fallen, or "
+            "leaning on the side panel); it was not grasped");
+  r.books[0].grasp_successes = 1;  // held all the same: whatever failed after it is named as before
+  r.books[0].place_after_holder_release = "other";
+  EXPECT_EQ(failure_reason(r, 1), "BOOK_NOT_ON_HOLDER after RELEASE_ON_HOLDER: the book is other");
+}
+
 TEST(FullCycleMetrics, AGraspThatTookAnotherBookAlongIsADoubleLift) {
   // Book 0's grasp took book 2 out of the shelf with it: the grasp is no success, the scene's failure is named
   // DOUBLE_LIFT before anything that follows from it, and book 2 (never targeted) is off the upper shelf.
