@@ -143,6 +143,9 @@ void write_report(const std::string& dir, const EvalMetrics& m, const std::strin
      << pct(m.books_upright_on_lower_shelf, m.books_upright_checked) << " | - |\n";
   md << "| books left on the holder for the librarian: too tall for the lower shelf / not placeable there | "
      << m.books_handed_over - m.books_handed_over_unplaceable << " / " << m.books_handed_over_unplaceable << " | - |\n";
+  md << "| right-most books that did not stand (fallen, or leaning on the side panel), passed over for the right-most "
+        "standing book | "
+     << m.books_passed_over_not_standing << " | - |\n";
   md << "| P1-P2 agreement (|dY| <= 15 mm, |dX| <= 20 mm) | " << pct(m.decisions_agreeing, m.decisions) << " | 80 % |\n";
   md << "| ... disagreeing: P1 off in Y (another book) / above the corner (X, on a taller neighbour) / below it / P2 "
         "off "

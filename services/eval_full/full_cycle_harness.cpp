@@ -530,15 +530,39 @@ struct FullCycleHarness::Impl {
     }
     if (target_book_id >= 0 && m->current_book >= 0 && m->current_book < static_cast<int>(res.books.size())) {
       // Does the target still stand? Books fall by themselves in some scenes (a neighbour leaning onto the right-most
-      // one, a thin book creeping over): the failure is then named for that, not for what followed.
+      // one, a thin book creeping over). Until the book's first close, a target that does not stand is passed over:
+      // the target becomes the right-most standing book (the paper's grasp takes standing books; the arbiter's
+      // "no corner from P1: BwH from PS" is there for a book leaning on the side panel).
       BookRecord& b = res.books[m->current_book];
       const book_truth_t* tb = truth_book(now_truth, b.truth_id);
-      if (tb && b.truth_id == target_book_id && b.grasp_attempts == 0 && b.not_standing_s < 0 &&
-          tb->place == "upper_shelf" && height_axis_tilt_deg(tb->pose) > kStandingMaxTiltDeg) {
-        b.not_standing_s = rel_s(m->utime);
-        b.not_standing_tilt_deg = height_axis_tilt_deg(tb->pose);
-        trace("TRUTH RIGHT-MOST NOT STANDING: book id " + std::to_string(b.truth_id) +
-              fmt(" leans %.1f deg from upright", b.not_standing_tilt_deg) + " (entering " + m->state + ")");
+      const bool seen = std::find(b.passed_over_not_standing.begin(), b.passed_over_not_standing.end(),
+                                  b.truth_id) != b.passed_over_not_standing.end();  // and no book stood then
+      if (tb && !seen && b.truth_id == target_book_id && b.grasp_attempts == 0 && tb->place == "upper_shelf" &&
+          height_axis_tilt_deg(tb->pose) > kStandingMaxTiltDeg) {
+        const book_truth_t* standing = nullptr;
+        for (const auto& k : now_truth.books)
+          if (k.place == "upper_shelf" && height_axis_tilt_deg(k.pose) <= kStandingMaxTiltDeg &&
+              (!standing || true_grasp(vec3(k.p1_base)).y() > true_grasp(vec3(standing->p1_base)).y()))
+            standing = &k;
+        std::string passed;
+        for (const auto& k : now_truth.books)
+          if (k.place == "upper_shelf" && height_axis_tilt_deg(k.pose) > kStandingMaxTiltDeg &&
+              (!standing || true_grasp(vec3(k.p1_base)).y() > true_grasp(vec3(standing->p1_base)).y()) &&
+              std::find(b.passed_over_not_standing.begin(), b.passed_over_not_standing.end(), k.id) ==
+                  b.passed_over_not_standing.end()) {
+            b.passed_over_not_standing.push_back(k.id);
+            passed += " " + std::to_string(k.id) + fmt(" (%.1f deg)", height_axis_tilt_deg(k.pose));
+          }
+        if (b.not_standing_s < 0) b.not_standing_s = rel_s(m->utime);
+        trace("TRUTH RIGHT-MOST NOT STANDING (entering " + m->state + "): book id(s)" + passed +
+              " passed over; the target is now " +
+              (standing ? "book id " + std::to_string(standing->id) + ", the right-most standing book"
+                        : std::string("none (no book stands)")));
+        if (standing) {
+          b.truth_id = standing->id;
+          b.true_width_m = standing->width_m;
+        }
+        target_book_id = b.truth_id;
       }
     }
     if (m->state == "CLOSE_GRIPPER") {

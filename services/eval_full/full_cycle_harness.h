@@ -85,7 +85,9 @@ inline constexpr double kStandingMaxTiltDeg = 10.0;
 /// One book taken (or tried) by the cycle.
 struct BookRecord {
   int index = 0;                     ///< order in the cycle (0 = first)
-  int truth_id = -1;                 ///< SIM_GROUND_TRUTH id of the book (right-most at the start of the book)
+  /// SIM_GROUND_TRUTH id of the book: right-most on the upper shelf at the start of the book, or the right-most
+  /// standing one when that does not stand (passed_over_not_standing).
+  int truth_id = -1;
   double true_width_m = 0;
   double measured_width_m = -1;      ///< arbiter BOOK_WIDTH (-1 = none)
   int grasp_attempts = 0;            ///< CLOSE_GRIPPER entries for this book (from the shelf)
@@ -107,11 +109,11 @@ struct BookRecord {
   /// ledge (truth: lowest corner within 2 cm of the ledge, its up within 35 deg of the back plate's), 0 = it
   /// does not (fell over, lies on the base, ...), -1 = not reached.
   int standing_on_holder = -1;
-  /// Truth: the first TASK_STATUS change before this book's first close at which it leaned more than
-  /// kStandingMaxTiltDeg from upright on the upper shelf (fallen over, or leaning on the side panel), in message time
-  /// (s from start); -1 = it stood at every change up to its first close.
-  double not_standing_s = -1;
-  double not_standing_tilt_deg = 0;  ///< its tilt then, deg
+  /// Books right of this one on the upper shelf that leaned more than kStandingMaxTiltDeg (fallen over, or leaning on
+  /// the side panel) at a TASK_STATUS change before this book's first close, in the order seen. While one did, the
+  /// harness passed it over: truth_id became the right-most standing book (the paper's grasp takes standing books).
+  std::vector<int> passed_over_not_standing;
+  double not_standing_s = -1;        ///< message time (s from start) the first of them was seen not standing; -1 = none
   double start_s = 0;                ///< message time the book's attempt started (s from start)
   double end_s = -1;                 ///< message time it was counted moved
 };

@@ -67,11 +67,6 @@ int books_on_lower_shelf(const FullCycleResult& r) {
 std::string failure_reason(const FullCycleResult& r, int max_books) {
   if (r.end == "ERROR") return "ERROR: " + r.message;
   for (const auto& b : r.books)
-    if (b.not_standing_s >= 0 && b.grasp_successes == 0)
-      return "RIGHTMOST_NOT_STANDING before its first close: the right-most book leaned more than " +
-             std::to_string(static_cast<int>(kStandingMaxTiltDeg)) +
-             " deg (fallen, or leaning on the side panel); it was not grasped";
-  for (const auto& b : r.books)
     if (!b.carried_along.empty())
       return "DOUBLE_LIFT: a grasp took " + std::to_string(b.carried_along.size()) +
              " other book(s) out of the shelf with the target";
@@ -132,6 +127,11 @@ std::string failure_reason(const FullCycleResult& r, int max_books) {
   }
   if (r.grasp_attempts > r.grasp_successes) return "GRASP_RETRIED: a grasp did not hold the book";
   for (const auto& b : r.books)
+    if (!b.passed_over_not_standing.empty())
+      return "RIGHTMOST_NOT_STANDING: the right-most book leaned more than " +
+             std::to_string(static_cast<int>(kStandingMaxTiltDeg)) +
+             " deg (fallen, or leaning on the side panel); the right-most standing book was the target";
+  for (const auto& b : r.books)
     if (b.handed_over && b.handed_over_unplaceable)
       return "HANDED_OVER: the lower shelf could not take a book; it went back to the holder for the librarian";
   for (const auto& b : r.books)
@@ -161,6 +161,7 @@ void accumulate(const SceneOutcome& o, int max_books, const MetricTolerances& to
   m->books_moved += std::min(moved, targeted > 0 ? targeted : moved);
   for (const auto& b : r.books) {
     m->books_handed_over += b.handed_over ? 1 : 0;
+    m->books_passed_over_not_standing += static_cast<int>(b.passed_over_not_standing.size());
     m->books_handed_over_unplaceable += b.handed_over && b.handed_over_unplaceable ? 1 : 0;
   }
   for (const auto& b : r.books) {
@@ -271,6 +272,7 @@ std::string metrics_json(const EvalMetrics& m, const std::string& command) {
   j << "  \"books_moved\": " << m.books_moved << ",\n";
   j << "  \"books_moved_rate\": " << rate(m.books_moved, m.books_targeted) << ",\n";
   j << "  \"books_handed_over\": " << m.books_handed_over << ",\n";
+  j << "  \"books_passed_over_not_standing\": " << m.books_passed_over_not_standing << ",\n";
   j << "  \"books_handed_over_unplaceable\": " << m.books_handed_over_unplaceable << ",\n";
   j << "  \"grasp_attempts\": " << m.grasp_attempts << ",\n";
   j << "  \"grasp_successes\": " << m.grasp_successes << ",\n";

@@ -58,6 +58,9 @@ struct EvalMetrics {
   int books_moved = 0;
   int books_handed_over = 0;  ///< too tall for, or not placeable on, the lower shelf: left for the librarian
   int books_handed_over_unplaceable = 0;  ///< ... of them because the lower shelf could not take them
+  /// Right-most books that did not stand (BookRecord::passed_over_not_standing): left on the upper shelf, the
+  /// right-most standing book taken as the target instead. Scene records before stop 42 lack it (0).
+  int books_passed_over_not_standing = 0;
   int grasp_attempts = 0;
   int grasp_successes = 0;      ///< grasps that held the target and no other book
   int books_carried_along = 0;  ///< other books a grasp took out of the shelf with the target
@@ -110,11 +113,12 @@ std::vector<int> untargeted_books_off_the_upper_shelf(const FullCycleResult& r);
 /// Books the coordinator moved (TASK_STATUS books_moved) that the truth has on the lower shelf at the end.
 int books_on_lower_shelf(const FullCycleResult& r);
 
-/// The failure class of a scene ("" = none): ERROR, RIGHTMOST_NOT_STANDING (a target that leaned more than
-/// kStandingMaxTiltDeg before its first close and was never held: named before what followed from it), DOUBLE_LIFT (a
+/// The failure class of a scene ("" = none): ERROR, DOUBLE_LIFT (a
 /// grasp took other books along), BOOK_NOT_ON_HOLDER (a released book that the truth does not place on the holder:
 /// named before the abort it leads to), BOOK_NOT_ON_LOWER_SHELF (a book the coordinator moved that the truth does not
-/// have on the lower shelf), OTHER_BOOK_OFF_THE_UPPER_SHELF, ABORTED: <state>, BUDGET in <state>, GRASP_RETRIED, ...
+/// have on the lower shelf), OTHER_BOOK_OFF_THE_UPPER_SHELF, ABORTED: <state>, BUDGET in <state>, GRASP_RETRIED, ...,
+/// and when nothing else failed RIGHTMOST_NOT_STANDING (a right-most book passed over:
+/// BookRecord::passed_over_not_standing) or HANDED_OVER.
 std::string failure_reason(const FullCycleResult& r, int max_books);
 
 /// Accumulates `outcome` into `m` (max_books as given to the harness, 0 = all books).

@@ -22,6 +22,7 @@ auto counts(M& m) {
       {"books_moved", &m.books_moved},
       {"books_handed_over", &m.books_handed_over},
       {"books_handed_over_unplaceable", &m.books_handed_over_unplaceable},
+      {"books_passed_over_not_standing", &m.books_passed_over_not_standing},
       {"grasp_attempts", &m.grasp_attempts},
       {"grasp_successes", &m.grasp_successes},
       {"books_carried_along", &m.books_carried_along},
@@ -74,10 +75,12 @@ auto samples(M& m) {
 }
 
 /// Keys added after the first scene records (stop 28: the plate samples; stop 31: the upright counts; stop 41: the
-/// stripe end and the P1-P2 disagreements by mode): a record without them measured none (empty, 0).
+/// stripe end and the P1-P2 disagreements by mode; stop 42: the books passed over): a record without them measured
+/// none (empty, 0).
 bool added_later(const std::string& key) {
   return key.rfind("plates_over_fore_edge_mm_", 0) == 0 || key.rfind("books_upright_", 0) == 0 ||
-         key.rfind("stripe", 0) == 0 || key.rfind("p1_p2_disagree_", 0) == 0;
+         key.rfind("stripe", 0) == 0 || key.rfind("p1_p2_disagree_", 0) == 0 ||
+         key == std::string("books_passed_over_not_standing");
 }
 
 std::string exact(double v) {

@@ -102,3 +102,13 @@ TEST(EvalReport, TheDisagreementsAreCountedByMode) {
   const std::string report = report_text(dir);
   EXPECT_NE(report.find("P2 off (P1 near the corner) | 1 / 2 / 3 / 0 |"), std::string::npos) << report;
 }
+
+TEST(EvalReport, TheBooksPassedOverHaveTheirRow) {
+  const std::string dir = testing::TempDir() + "/eval_report_passed_over";
+  ASSERT_EQ(std::system(("mkdir -p " + dir).c_str()), 0);
+  EvalMetrics m = half_upright();
+  m.books_passed_over_not_standing = 3;
+  write_report(dir, m, "test", 0);
+  const std::string report = report_text(dir);
+  EXPECT_NE(report.find("passed over for the right-most standing book | 3 |"), std::string::npos) << report;
+}

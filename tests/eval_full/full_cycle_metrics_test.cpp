@@ -195,31 +195,45 @@ TEST(FullCycleMetrics, FailureReasons) {
   EXPECT_EQ(failure_reason(r, 1), "ABORTED in MOVE_TO_HOLDER_PRE_GRASP: plan failed");
 }
 
-// Seed 5498's shape: the right-most book fell over before the first close, the cycle took another book and put it
-// on the holder. The failure is the fallen book, named before the holder's "not on it" that follows from it; a target
-// that fell and was grasped all the same is not this failure.
-TEST(FullCycleMetrics, ARightMostBookThatFellBeforeItsFirstCloseIsNamedFirst) {
+// The right-most book fell over before the first close (far_cart 5247, 5456): the harness passed it over and the
+// right-most standing book was the target. A scene where that went well names RIGHTMOST_NOT_STANDING (a shortfall
+// like HANDED_OVER, counted in books_passed_over_not_standing); one where the target's grasp then failed names that.
+TEST(FullCycleMetrics, ARightMostBookPassedOverIsCountedAndNamedLast) {
   FullCycleResult r;
   r.end = "BOOKS";
-  r.final_truth.books = {truth_book("upper_shelf", 0), truth_book("other", 2)};
-  BookRecord fell;
-  fell.truth_id = 0;
-  fell.grasp_attempts = 1;
-  fell.place_after_holder_release = "upper_shelf";
-  fell.handed_over = true;
-  r.books = {fell};
-  r.grasp_attempts = 1;
-  const std::string not_on_holder =
-      "BOOK_NOT_ON_HOLDER after RELEASE_ON_HOLDER: the book is upper_shelf (it was not in the plates after EXTRACT)";
-  EXPECT_EQ(failure_reason(r, 1), not_on_holder) << "standing (not_standing_s < 0): the old name";
-  r.books[0].not_standing_s = 7.0;
-  r.books[0].not_standing_tilt_deg = 49.6;
+  r.books_moved = 1;
+  r.final_truth.books = {truth_book("upper_shelf", 0), truth_book("lower_shelf", 2)};
+  BookRecord taken;
+  taken.truth_id = 2;
+  taken.passed_over_not_standing = {0};
+  taken.grasp_attempts = taken.grasp_successes = 1;
+  taken.place_after_holder_release = "holder";
+  taken.moved = true;
+  r.books = {taken};
+  r.grasp_attempts = r.grasp_successes = 1;
+  const std::string passed_over =
+      "RIGHTMOST_NOT_STANDING: the right-most book leaned more than 10 deg (fallen, or leaning on the side panel); the "
+      "right-most standing book was the target";
+  EXPECT_EQ(failure_reason(r, 1), passed_over);
+  EvalMetrics m;
+  accumulate(SceneOutcome{5247, r}, 1, MetricTolerances{}, &m);
+  EXPECT_EQ(m.books_passed_over_not_standing, 1);
+  EXPECT_EQ(m.grasp_successes, 1);
+  EXPECT_EQ(m.books_moved, 1);
+  EXPECT_NE(metrics_json(m, "test").find("\"books_passed_over_not_standing\": 1,"), std::string::npos);
+  // Far_cart 5498: another standing book was grasped than the right-most standing one; what failed is named.
+  r.books[0].grasp_successes = 0;
+  r.grasp_successes = 0;
+  r.books[0].place_after_holder_release = "upper_shelf";
+  r.final_truth.books[1].place = "upper_shelf";
   EXPECT_EQ(failure_reason(r, 1),
-            "RIGHTMOST_NOT_STANDING before its first close: the right-most book leaned more than 10 deg (fallen, or "
-            "leaning on the side panel); it was not grasped");
-  r.books[0].grasp_successes = 1;  // held all the same: whatever failed after it is named as before
-  r.books[0].place_after_holder_release = "other";
-  EXPECT_EQ(failure_reason(r, 1), "BOOK_NOT_ON_HOLDER after RELEASE_ON_HOLDER: the book is other");
+            "BOOK_NOT_ON_HOLDER after RELEASE_ON_HOLDER: the book is upper_shelf (it was not in the plates after "
+            "EXTRACT)");
+  r.books[0].passed_over_not_standing.clear();  // without a passed-over book, a scene that went well names nothing
+  r.books[0].grasp_successes = r.grasp_successes = 1;
+  r.books[0].place_after_holder_release = "holder";
+  r.final_truth.books[1].place = "lower_shelf";
+  EXPECT_EQ(failure_reason(r, 1), "");
 }
 
 TEST(FullCycleMetrics, AGraspThatTookAnotherBookAlongIsADoubleLift) {

@@ -165,6 +165,20 @@ TEST(SceneRecord, StripeEndsAndDisagreementsRoundTripAndARecordFromBeforeThemRea
   EXPECT_EQ(before.metrics.width_error_mm, r.metrics.width_error_mm);
 }
 
+TEST(SceneRecord, BooksPassedOverRoundTripAndARecordFromBeforeThemReadsAsNone) {
+  SceneOutcome o = other_scene(17);
+  o.result.books[0].passed_over_not_standing = {3, 4};
+  const SceneRecord r = record_of(o);
+  EXPECT_EQ(r.metrics.books_passed_over_not_standing, 2);
+  EXPECT_EQ(parse_scene_record(scene_record_yaml(r), "test").metrics.books_passed_over_not_standing, 2);
+  // A record of 5e55419 (no such key, docs/eval_runs): read, none passed over.
+  const std::string old_text = without_keys(scene_record_yaml(r), "books_passed_over");
+  ASSERT_NE(old_text, scene_record_yaml(r));
+  const SceneRecord before = parse_scene_record(old_text, "full-5e55419/out_5000/scenes/seed_17.yaml");
+  EXPECT_EQ(before.metrics.books_passed_over_not_standing, 0);
+  EXPECT_EQ(before.metrics.grasp_attempts, r.metrics.grasp_attempts);
+}
+
 TEST(SceneRecord, ABadFileIsNamedWithItsKey) {
   std::string text = scene_record_yaml(record_of(done_scene(1)));
   const auto at = text.find("grasp_attempts:");
