@@ -417,7 +417,12 @@ struct FullCycleHarness::Impl {
       StripeRecord s;
       s.book_index = status.current_book;
       s.ps_true_grasp = true_grasp(pose_to_isometry(m->converged_pose).translation());
-      s.end_true_grasp = true_grasp(vec3(gt.stripe_end_base));
+      // The truth's stripe end is that of the right-most book; where that one does not stand (passed over, above),
+      // the right-most standing book's edge is where the stripe should end.
+      const book_truth_t* st = rightmost_standing(gt);
+      s.end_true_grasp =
+          true_grasp(st ? scene::stripe_end(scene, pose_to_isometry(st->pose), st->width_m, st->height_m, st->depth_m)
+                        : vec3(gt.stripe_end_base));
       const Eigen::Vector3d e = (s.ps_true_grasp - s.end_true_grasp) * 1e3;
       trace(fmt("TRUTH PS - true stripe end (%.1f, ", e.x()) + fmt("%.1f) mm (X, Y)", e.y()));
       res.stripes.push_back(s);
@@ -452,6 +457,16 @@ struct FullCycleHarness::Impl {
   }
 
   /// True P1 of a book in the cart's true grasp frame (X up, Y right, Z into the shelf).
+  /// The right-most book standing on the upper shelf (height axis within kStandingMaxTiltDeg of upright), or nullptr.
+  const book_truth_t* rightmost_standing(const ground_truth_t& g) const {
+    const book_truth_t* standing = nullptr;
+    for (const auto& k : g.books)
+      if (k.place == "upper_shelf" && height_axis_tilt_deg(k.pose) <= kStandingMaxTiltDeg &&
+          (!standing || true_grasp(vec3(k.p1_base)).y() > true_grasp(vec3(standing->p1_base)).y()))
+        standing = &k;
+    return standing;
+  }
+
   Eigen::Vector3d true_grasp(const Eigen::Vector3d& p_base) const {
     const Eigen::Vector3d c = scene.cart_pose.inverse() * p_base;
     return Eigen::Vector3d(c.z(), -c.y(), c.x());
@@ -539,11 +554,7 @@ struct FullCycleHarness::Impl {
                                   b.truth_id) != b.passed_over_not_standing.end();  // and no book stood then
       if (tb && !seen && b.truth_id == target_book_id && b.grasp_attempts == 0 && tb->place == "upper_shelf" &&
           height_axis_tilt_deg(tb->pose) > kStandingMaxTiltDeg) {
-        const book_truth_t* standing = nullptr;
-        for (const auto& k : now_truth.books)
-          if (k.place == "upper_shelf" && height_axis_tilt_deg(k.pose) <= kStandingMaxTiltDeg &&
-              (!standing || true_grasp(vec3(k.p1_base)).y() > true_grasp(vec3(standing->p1_base)).y()))
-            standing = &k;
+        const book_truth_t* standing = rightmost_standing(now_truth);
         std::string passed;
         for (const auto& k : now_truth.books)
           if (k.place == "upper_shelf" && height_axis_tilt_deg(k.pose) > kStandingMaxTiltDeg &&

@@ -140,6 +140,11 @@ TEST(FullCycle, RightMostBooksThatFellArePassedOverAndTheRightMostStandingOneIsG
   EXPECT_EQ(r.books[0].truth_id, standing);
   EXPECT_EQ(r.grasp_attempts, 1);
   EXPECT_EQ(r.grasp_successes, 1) << "the right-most standing book held alone after EXTRACT\n" << describe(r);
+  // The stripe end is compared with the right-most standing book's edge, not with the fallen book's.
+  ASSERT_FALSE(r.stripes.empty());
+  const Eigen::Vector3d ps_error = r.stripes.front().ps_true_grasp - r.stripes.front().end_true_grasp;
+  EXPECT_LE(std::abs(ps_error.x()), 0.015) << "PS - the standing book's stripe end in X (up), m";
+  EXPECT_LE(std::abs(ps_error.y()), 0.010) << "PS - the standing book's stripe end in Y (right), m";
 }
 
 // The coordinator is destroyed with the book on the holder and rebuilt from its progress file: the new one
