@@ -456,7 +456,6 @@ struct FullCycleHarness::Impl {
     return res.books[index];
   }
 
-  /// True P1 of a book in the cart's true grasp frame (X up, Y right, Z into the shelf).
   /// The right-most book standing on the upper shelf (height axis within kStandingMaxTiltDeg of upright), or nullptr.
   const book_truth_t* rightmost_standing(const ground_truth_t& g) const {
     const book_truth_t* standing = nullptr;
@@ -467,6 +466,7 @@ struct FullCycleHarness::Impl {
     return standing;
   }
 
+  /// True P1 of a book in the cart's true grasp frame (X up, Y right, Z into the shelf).
   Eigen::Vector3d true_grasp(const Eigen::Vector3d& p_base) const {
     const Eigen::Vector3d c = scene.cart_pose.inverse() * p_base;
     return Eigen::Vector3d(c.z(), -c.y(), c.x());
@@ -564,7 +564,6 @@ struct FullCycleHarness::Impl {
             b.passed_over_not_standing.push_back(k.id);
             passed += " " + std::to_string(k.id) + fmt(" (%.1f deg)", height_axis_tilt_deg(k.pose));
           }
-        if (b.not_standing_s < 0) b.not_standing_s = rel_s(m->utime);
         trace("TRUTH RIGHT-MOST NOT STANDING (entering " + m->state + "): book id(s)" + passed +
               " passed over; the target is now " +
               (standing ? "book id " + std::to_string(standing->id) + ", the right-most standing book"

@@ -113,7 +113,6 @@ struct BookRecord {
   /// the side panel) at a TASK_STATUS change before this book's first close, in the order seen. While one did, the
   /// harness passed it over: truth_id became the right-most standing book (the paper's grasp takes standing books).
   std::vector<int> passed_over_not_standing;
-  double not_standing_s = -1;        ///< message time (s from start) the first of them was seen not standing; -1 = none
   double start_s = 0;                ///< message time the book's attempt started (s from start)
   double end_s = -1;                 ///< message time it was counted moved
 };

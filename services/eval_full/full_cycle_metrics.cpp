@@ -161,8 +161,8 @@ void accumulate(const SceneOutcome& o, int max_books, const MetricTolerances& to
   m->books_moved += std::min(moved, targeted > 0 ? targeted : moved);
   for (const auto& b : r.books) {
     m->books_handed_over += b.handed_over ? 1 : 0;
-    m->books_passed_over_not_standing += static_cast<int>(b.passed_over_not_standing.size());
     m->books_handed_over_unplaceable += b.handed_over && b.handed_over_unplaceable ? 1 : 0;
+    m->books_passed_over_not_standing += static_cast<int>(b.passed_over_not_standing.size());
   }
   for (const auto& b : r.books) {
     if (!b.moved || final_place(r, b) != "lower_shelf") continue;
@@ -272,8 +272,8 @@ std::string metrics_json(const EvalMetrics& m, const std::string& command) {
   j << "  \"books_moved\": " << m.books_moved << ",\n";
   j << "  \"books_moved_rate\": " << rate(m.books_moved, m.books_targeted) << ",\n";
   j << "  \"books_handed_over\": " << m.books_handed_over << ",\n";
-  j << "  \"books_passed_over_not_standing\": " << m.books_passed_over_not_standing << ",\n";
   j << "  \"books_handed_over_unplaceable\": " << m.books_handed_over_unplaceable << ",\n";
+  j << "  \"books_passed_over_not_standing\": " << m.books_passed_over_not_standing << ",\n";
   j << "  \"grasp_attempts\": " << m.grasp_attempts << ",\n";
   j << "  \"grasp_successes\": " << m.grasp_successes << ",\n";
   j << "  \"grasp_success_rate\": " << rate(m.grasp_successes, m.grasp_attempts) << ",\n";

@@ -113,12 +113,11 @@ std::vector<int> untargeted_books_off_the_upper_shelf(const FullCycleResult& r);
 /// Books the coordinator moved (TASK_STATUS books_moved) that the truth has on the lower shelf at the end.
 int books_on_lower_shelf(const FullCycleResult& r);
 
-/// The failure class of a scene ("" = none): ERROR, DOUBLE_LIFT (a
-/// grasp took other books along), BOOK_NOT_ON_HOLDER (a released book that the truth does not place on the holder:
-/// named before the abort it leads to), BOOK_NOT_ON_LOWER_SHELF (a book the coordinator moved that the truth does not
-/// have on the lower shelf), OTHER_BOOK_OFF_THE_UPPER_SHELF, ABORTED: <state>, BUDGET in <state>, GRASP_RETRIED, ...,
-/// and when nothing else failed RIGHTMOST_NOT_STANDING (a right-most book passed over:
-/// BookRecord::passed_over_not_standing) or HANDED_OVER.
+/// The failure class of a scene ("" = none): ERROR, DOUBLE_LIFT (a grasp took other books along), BOOK_NOT_ON_HOLDER (a
+/// released book that the truth does not place on the holder: named before the abort it leads to),
+/// BOOK_NOT_ON_LOWER_SHELF (a book the coordinator moved that the truth does not have on the lower shelf),
+/// OTHER_BOOK_OFF_THE_UPPER_SHELF, ABORTED: <state>, BUDGET in <state>, GRASP_RETRIED, ..., and when nothing else
+/// failed RIGHTMOST_NOT_STANDING (a right-most book passed over: BookRecord::passed_over_not_standing) or HANDED_OVER.
 std::string failure_reason(const FullCycleResult& r, int max_books);
 
 /// Accumulates `outcome` into `m` (max_books as given to the harness, 0 = all books).

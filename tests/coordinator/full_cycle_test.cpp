@@ -126,7 +126,10 @@ TEST(FullCycle, RightMostBooksThatFellArePassedOverAndTheRightMostStandingOneIsG
       continue;
     }
     const double y = (cart_inv * Eigen::Vector3d(b.p1_base[0], b.p1_base[1], b.p1_base[2])).y();
-    if (y < right_y) right_y = y, standing = b.id;
+    if (y < right_y) {
+      right_y = y;
+      standing = b.id;
+    }
   }
   ASSERT_EQ(fallen, 2) << "books 0 and 1 lie flat";
   const std::string end = h.run_until(kBookBudgetS, 0, [&] {

@@ -11,9 +11,12 @@
 
 namespace {
 
-/// Runs the tool with `args`; returns its exit code and puts its stderr in `err`.
+/// Runs the tool with `args`; returns its exit code and puts its stderr in `err`. The stderr file is the running
+/// test's own: ctest runs the tests of this file side by side, and a shared file let one read the other's message
+/// (the clean-clone CI of 180b7ea).
 int run_tool(const std::string& args, std::string* err) {
-  const std::string err_file = ::testing::TempDir() + "/eval_full_cli_err.txt";
+  const std::string err_file = ::testing::TempDir() + "/eval_full_cli_err_" +
+                               ::testing::UnitTest::GetInstance()->current_test_info()->name() + ".txt";
   const std::string cmd = std::string(BOOKGRASP_EVAL_FULL_EXE) + " " + args + " >/dev/null 2>" + err_file;
   const int rc = std::system(cmd.c_str());
   std::ifstream f(err_file);
