@@ -456,13 +456,17 @@ struct FullCycleHarness::Impl {
     return res.books[index];
   }
 
-  /// The right-most book standing on the upper shelf (height axis within kStandingMaxTiltDeg of upright), or nullptr.
+  /// A book stands: its height axis within kStandingMaxTiltDeg of upright.
+  static bool stands(const book_truth_t& k) { return height_axis_tilt_deg(k.pose) <= kStandingMaxTiltDeg; }
+  /// Book `k`'s P1 lies right of book `o`'s (the true grasp frame's Y grows to the right).
+  bool right_of(const book_truth_t& k, const book_truth_t& o) const {
+    return true_grasp(vec3(k.p1_base)).y() > true_grasp(vec3(o.p1_base)).y();
+  }
+  /// The right-most book standing on the upper shelf, or nullptr.
   const book_truth_t* rightmost_standing(const ground_truth_t& g) const {
     const book_truth_t* standing = nullptr;
     for (const auto& k : g.books)
-      if (k.place == "upper_shelf" && height_axis_tilt_deg(k.pose) <= kStandingMaxTiltDeg &&
-          (!standing || true_grasp(vec3(k.p1_base)).y() > true_grasp(vec3(standing->p1_base)).y()))
-        standing = &k;
+      if (k.place == "upper_shelf" && stands(k) && (!standing || right_of(k, *standing))) standing = &k;
     return standing;
   }
 
@@ -553,12 +557,11 @@ struct FullCycleHarness::Impl {
       const bool seen = std::find(b.passed_over_not_standing.begin(), b.passed_over_not_standing.end(),
                                   b.truth_id) != b.passed_over_not_standing.end();  // and no book stood then
       if (tb && !seen && b.truth_id == target_book_id && b.grasp_attempts == 0 && tb->place == "upper_shelf" &&
-          height_axis_tilt_deg(tb->pose) > kStandingMaxTiltDeg) {
+          !stands(*tb)) {
         const book_truth_t* standing = rightmost_standing(now_truth);
         std::string passed;
         for (const auto& k : now_truth.books)
-          if (k.place == "upper_shelf" && height_axis_tilt_deg(k.pose) > kStandingMaxTiltDeg &&
-              (!standing || true_grasp(vec3(k.p1_base)).y() > true_grasp(vec3(standing->p1_base)).y()) &&
+          if (k.place == "upper_shelf" && !stands(k) && (!standing || right_of(k, *standing)) &&
               std::find(b.passed_over_not_standing.begin(), b.passed_over_not_standing.end(), k.id) ==
                   b.passed_over_not_standing.end()) {
             b.passed_over_not_standing.push_back(k.id);
