@@ -52,7 +52,9 @@ validation_step_t to_msg(const ValidationStep& s, int64_t utime) {
   return m;
 }
 
-bool finite3(const double (&v)[3]) { return std::isfinite(v[0]) && std::isfinite(v[1]) && std::isfinite(v[2]); }
+bool finite3(const double (&v)[3]) {
+  return std::isfinite(v[0]) && std::isfinite(v[1]) && std::isfinite(v[2]);
+}
 
 }  // namespace
 
@@ -136,20 +138,26 @@ ArbiterNode::ArbiterNode(const std::string& service, const std::string& implemen
   subscribe(s_.channels.detector_switch, &ArbiterNode::on_switch);
 }
 
-Eigen::Vector3d ArbiterNode::to_grasp(const Eigen::Vector3d& p_base) const { return frame_->inverse() * p_base; }
-Eigen::Vector3d ArbiterNode::to_base(const Eigen::Vector3d& p_grasp) const { return *frame_ * p_grasp; }
+Eigen::Vector3d ArbiterNode::to_grasp(const Eigen::Vector3d& p_base) const {
+  return frame_->inverse() * p_base;
+}
+Eigen::Vector3d ArbiterNode::to_base(const Eigen::Vector3d& p_grasp) const {
+  return *frame_ * p_grasp;
+}
 
 void ArbiterNode::open_attempt() {
   frozen_ = false;
   frozen_p1_.reset();
   frozen_regions_.clear();
+  attempt_check_dy_.reset();
 }
 
 void ArbiterNode::on_markers(const marker_detections_t& msg) {
   for (const marker_t& m : msg.markers) {
     if (m.role != s_.cart_marker_role) continue;
     if (!is_valid_pose(m.pose_in_base)) {
-      reject(s_.channels.markers, "cart marker " + std::to_string(m.id) + " has an invalid pose_in_base (NaN or not a unit quaternion)");
+      reject(s_.channels.markers,
+             "cart marker " + std::to_string(m.id) + " has an invalid pose_in_base (NaN or not a unit quaternion)");
       return;
     }
     const Eigen::Isometry3d t = pose_to_isometry(m.pose_in_base);
@@ -183,8 +191,8 @@ void ArbiterNode::on_switch(const detector_switch_t& msg) {
     have_p1_msg_ = false;
   }
   // Visible in SERVICE_STATUS.last_error (the runtime has no other free-text field).
-  report_error("detector switch: now following " + s_.follow_logical_channel + " implementation '" + follow_ +
-               "', " + switch_note_);
+  report_error("detector switch: now following " + s_.follow_logical_channel + " implementation '" + follow_ + "', " +
+               switch_note_);
 }
 
 void ArbiterNode::on_book_corner(const book_corner_stereo_t& msg) {
@@ -227,6 +235,11 @@ void ArbiterNode::on_servo_request(const servo_request_t& msg) {
     frozen_regions_ = latest_regions_;
   }
   if (msg.mode == servo_request_t::BOOK_CORNER) {
+    // The coordinator started BwH where the last P1 check said: if that check judged the attempt's P1, its
+    // verdict holds for the attempt's decisions.
+    if (!attempt_check_dy_ && last_check_ && frozen_p1_ && ps_ && last_check_->p1_base == *frozen_p1_ &&
+        last_check_->ps_base == *ps_)
+      attempt_check_dy_ = last_check_->dy;
     rank_of_request_[msg.request_id] = msg.rank_from_right;
     while (rank_of_request_.size() > 64) rank_of_request_.erase(rank_of_request_.begin());
   }
@@ -289,6 +302,7 @@ void finish(grasp_point_t* m, const std::string& follow, const std::string& swit
 }  // namespace
 
 void ArbiterNode::publish_p1_check(int64_t utime, int64_t request_id) {
+  last_check_.reset();
   if (!frame_) {
     report_error("P1 check skipped: no cart marker seen yet, the grasp frame is unknown");
     return;
@@ -307,6 +321,7 @@ void ArbiterNode::publish_p1_check(int64_t utime, int64_t request_id) {
   }
   const CombinationInputs in = common_inputs();
   put(m.ps_grasp, in.ps);
+  if (p1b && in.p1->allFinite()) last_check_ = P1Check{*p1b, *ps_, in.p1->y() - in.ps.y()};
   const CombinationResult r = validate_p1(in, s_.tolerances);
   for (const ValidationStep& st : r.steps) m.steps.push_back(to_msg(st, utime));
   if (!r.p1_valid) {  // the depth the corner servo assumes (GP.z will take the same), as gp_grasp's Z
@@ -340,6 +355,7 @@ void ArbiterNode::decide(const servo_status_t& msg) {
     return;
   }
   CombinationInputs in = common_inputs();
+  in.p1_ps_dy_at_bwh_start = attempt_check_dy_;
   const auto rank_it = rank_of_request_.find(msg.request_id);
   in.p2_rank = rank_it == rank_of_request_.end() ? 0 : rank_it->second;
   double slope = 0;
@@ -369,7 +385,8 @@ void ArbiterNode::decide(const servo_status_t& msg) {
       if (use_slope) rot = rot * Eigen::AngleAxisd(slope, Eigen::Vector3d::UnitZ()).toRotationMatrix();
       r.steps.push_back({"GP slope", slope, s_.max_slope_rad, use_slope || !s_.align_with_book_slope,
                          !s_.align_with_book_slope ? "GP keeps the grasp-frame orientation (alignment off)"
-                         : use_slope ? "gripper aligned with the book slope from BwH"
+                         : use_slope
+                             ? "gripper aligned with the book slope from BwH"
                                      : "servo slope beyond gp.max_slope_deg: not trusted, grasp-frame orientation kept"});
       Eigen::Isometry3d gp = Eigen::Isometry3d::Identity();
       gp.linear() = rot;

@@ -131,6 +131,16 @@ class ArbiterNode : public Component {
   std::vector<plane_region_t> latest_regions_;  ///< the followed BwS frame's regions (base)
   std::vector<plane_region_t> frozen_regions_;  ///< ... of the attempt
   bool frozen_ = false;
+  /// The last P1 check: the P1 and PS (base) it judged and P1.y - PS.y (grasp frame) it measured.
+  struct P1Check {
+    Eigen::Vector3d p1_base;
+    Eigen::Vector3d ps_base;
+    double dy = 0.0;
+  };
+  std::optional<P1Check> last_check_;
+  /// last_check_'s dy when the attempt's first BOOK_CORNER request came with that check's P1 frozen: the attempt's
+  /// decisions judge P1 on it (CombinationInputs::p1_ps_dy_at_bwh_start).
+  std::optional<double> attempt_check_dy_;
   std::optional<Eigen::Vector3d> ps_;          ///< base
   bool ps_measured_ = false;                   ///< ps_ is the stripe servo's end, not GP.y - BW
   /// The PS (base) at which a valid P1 led BwH to a left neighbour's corner (GraspOutcome::kP1LedAstray): at the

@@ -29,15 +29,18 @@ CombinationResult fail(CombinationResult r, const std::string& rule, const std::
 
 std::string outcome_name(GraspOutcome o) {
   switch (o) {
-    case GraspOutcome::kGrasp: return "GRASP";
-    case GraspOutcome::kNextRegion: return "NEXT_REGION";
+    case GraspOutcome::kGrasp:
+      return "GRASP";
+    case GraspOutcome::kNextRegion:
+      return "NEXT_REGION";
     case GraspOutcome::kP1LedAstray:
       return "P1_LED_ASTRAY";
     case GraspOutcome::kRaiseBwhStart:
       return "RAISE_BWH_START";
     case GraspOutcome::kStartFromP1:
       return "START_FROM_P1";
-    case GraspOutcome::kNoGrasp: return "NO_GRASP";
+    case GraspOutcome::kNoGrasp:
+      return "NO_GRASP";
   }
   return "?";
 }
@@ -84,10 +87,12 @@ CombinationResult validate_p1_against_ps(const CombinationInputs& in, const Comb
     return r;
   }
   if (!in.p1->allFinite()) {
-    r.steps.push_back(step("P1.y vs PS.y", NAN, tol.p1_ps_y, false, "P1 is not finite: ignore BwS, BwH starts from PS"));
+    r.steps.push_back(
+        step("P1.y vs PS.y", NAN, tol.p1_ps_y, false, "P1 is not finite: ignore BwS, BwH starts from PS"));
     return r;
   }
-  const double d = in.p1->y() - in.ps.y();
+  const double now = in.p1->y() - in.ps.y();
+  const double d = in.p1_ps_dy_at_bwh_start.value_or(now);
   if (in.p1_led_astray) {
     r.steps.push_back(step("P1 led BwH astray", d, tol.p1_ps_y, false,
                            "P1 (" + mm(d) +
@@ -123,7 +128,8 @@ CombinationResult validate_p1_against_ps(const CombinationInputs& in, const Comb
     }
   } else {
     r.steps.push_back(step("P1.y vs PS.y", d, tol.p1_ps_y, false,
-                           "P1 invalid (" + mm(d) + " from PS, e.g. a thin book BwS missed): ignore BwS, BwH "
+                           "P1 invalid (" + mm(d) +
+                               " from PS, e.g. a thin book BwS missed): ignore BwS, BwH "
                            "starts from PS"));
   }
   return r;
@@ -133,6 +139,12 @@ CombinationResult validate_p1_against_ps(const CombinationInputs& in, const Comb
 
 CombinationResult validate_p1(const CombinationInputs& in, const CombinationTolerances& tol) {
   CombinationResult r = validate_p1_against_ps(in, tol);
+  if (in.p1_ps_dy_at_bwh_start && in.p1 && in.p1->allFinite() && in.ps.allFinite() && !r.steps.empty()) {
+    const double now = in.p1->y() - in.ps.y();
+    if (std::abs(*in.p1_ps_dy_at_bwh_start - now) > 5e-5)
+      r.steps.back().decision +=
+          " (P1 " + mm(*in.p1_ps_dy_at_bwh_start) + " from PS as when BwH started from it; now " + mm(now) + ")";
+  }
   if (r.p1_valid || !in.bwh_start_raised || !(tol.raised_bwh_start_x > 0) || !r.bwh_start.allFinite()) return r;
   if (bwh_started_from_p1_right_of_ps(r)) return r;  // BwH does not start from PS
   const double ps_x = r.bwh_start.x();
@@ -274,7 +286,8 @@ CombinationResult combine(const CombinationInputs& in, const CombinationToleranc
     r.steps.push_back(step("P2.y vs " + ref_name + ".y", dy, tol.y, true, "P2.y valid: within the Y tolerance"));
   } else if (dy < 0) {
     r.steps.push_back(step("P2.y vs " + ref_name + ".y", dy, tol.y, true,
-                           "P2.y valid: " + ref_name + " lies right of P2 and BwH already delivered the right-most "
+                           "P2.y valid: " + ref_name +
+                               " lies right of P2 and BwH already delivered the right-most "
                            "region"));
   } else if (!r.p1_valid && tol.p1_p2_agreement_over_ps && in.p1 && in.p1->allFinite() &&
              std::abs(p2.y() - in.p1->y()) < tol.y) {
@@ -347,9 +360,9 @@ ValidationStep check_book_width(double width, const BookSizeLimits& limits) {
                 "book wider than S_max = L_max/2 - TCP offset (" + mm(limits.s_max()) +
                     "): the open left plate lands on the book itself");
   if (width < limits.s_min())
-    return step("book width >= S_min", width, limits.s_min(), false,
-                "book thinner than S_min = S_max/2 (" + mm(limits.s_min()) +
-                    "): the left plate may reach the book after next");
+    return step(
+        "book width >= S_min", width, limits.s_min(), false,
+        "book thinner than S_min = S_max/2 (" + mm(limits.s_min()) + "): the left plate may reach the book after next");
   return step("S_min <= book width <= S_max", width, limits.s_max(), true, "admissible book width " + mm(width));
 }
 

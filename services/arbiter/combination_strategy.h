@@ -139,6 +139,11 @@ struct CombinationInputs {
   /// At this PS, BwH started from a P1 right of it (CombinationTolerances::start_from_p1_right_of_measured_ps) and
   /// did not converge: BwH starts from PS.
   bool p1_right_start_failed = false;
+  /// P1.y - PS.y as the P1 check that started this attempt's BwH measured it (the same P1 and PS). When set, P1 is
+  /// judged on it instead of on p1 and ps: the node converts both from `base` with the grasp frame of the latest
+  /// cart marker, which moves between the check and the decision, and a P1 at the tolerance's edge would otherwise
+  /// change its verdict after BwH started from it (far_cart seed 5021: valid at 9.9 mm, invalid at the decision).
+  std::optional<double> p1_ps_dy_at_bwh_start;
 };
 
 /// Result: GP (grasp frame) and every step.

@@ -19,7 +19,9 @@ namespace bookgrasp {
 struct HandSceneSettings {
   std::string scene_file;  ///< scene YAML (e.g. services/eval_hand/scenes/hand_eval.yaml)
   std::string config_dir;  ///< config/services
-  Eigen::Vector3d station_a = Eigen::Vector3d(0.10, 0.30, -0.10);  ///< station A in the grasp frame (coordinator's)
+  /// Station A in the grasp frame: the coordinator's until stop 43 (it now starts at Y 0.36, coordinator.yaml), kept
+  /// here so the figures in docs/HAND_CAMERA.md stay comparable.
+  Eigen::Vector3d station_a = Eigen::Vector3d(0.10, 0.30, -0.10);
   double stripe_timeout_s = 20.0;                                  ///< SERVO_REQUEST.timeout_s of the stripe task
   double corner_standoff_m = 0.22;                                 ///< corner task: TCP to the book front
   double corner_max_offset_m = 0.05;  ///< corner start: P1 + an offset drawn (seeded) in a disc of this radius

@@ -10,9 +10,9 @@
 /// The stations (paper Figure 7) come from the scene's geometry and ground
 /// truth here, as the coordinator computes them from the cart marker and P1:
 ///  - station A: a point of the cart's grasp frame (origin at the upper shelf's
-///    front edge centre, X up, Y right, Z into the shelf), by default the
-///    coordinator's [0.10, 0.30, -0.10] (stripe height, right part of the
-///    stripe, 0.46 m in front of the rear board);
+///    front edge centre, X up, Y right, Z into the shelf), by default
+///    [0.10, 0.30, -0.10] (stripe height, right part of the stripe, 0.46 m in
+///    front of the rear board; the coordinator's until stop 43);
 ///  - corner start: the right-most book's P1 (+ an offset in the grasp frame's
 ///    X/Y), `corner_standoff_m` in front of it.
 /// The arm starts there (the scene's initial joints are replaced by an IK

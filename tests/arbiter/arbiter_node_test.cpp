@@ -122,7 +122,9 @@ void expect_vec(const double (&v)[3], const Eigen::Vector3d& want, const char* w
   for (int i = 0; i < 3; ++i) EXPECT_NEAR(v[i], want[i], kTol) << what << "[" << i << "]";
 }
 
-bool starts_with(const std::string& s, const std::string& p) { return s.rfind(p, 0) == 0; }
+bool starts_with(const std::string& s, const std::string& p) {
+  return s.rfind(p, 0) == 0;
+}
 
 class ArbiterNodeTest : public testing::Test {
  protected:
@@ -389,6 +391,33 @@ TEST_F(ArbiterNodeTest, AP1ThatLedBwhToTheNeighbourIsNotUsedAgainAtThatPs) {
   send("SERVO_STATUS", status(11000, 4, servo_request_t::STRIPE_END, servo_status_t::CONVERGED, {0.45, -0.297, 0.10}));
   ASSERT_EQ(out.got.size(), 6u);
   EXPECT_TRUE(starts_with(out.got[5].reason, "P1_VALID")) << out.got[5].reason;
+}
+
+// Far_cart seed 5021: P1 passed the PS check at 9.9 mm and BwH started from it; a cart marker turned by 2 mrad
+// before the decision moved P1 to 10.2 mm from PS in the new grasp frame. The decision keeps the check's verdict:
+// P2 15 mm left of the measured stripe end is the neighbour P1 led BwH to (P1_LED_ASTRAY: BwH from PS next), not a
+// shorter neighbour found from PS "without a valid P1" (RAISE_BWH_START, which sent BwH above every book there).
+TEST_F(ArbiterNodeTest, TheDecisionKeepsTheVerdictOfTheP1CheckThatStartedBwh) {
+  // P1 base y -0.2951 -> grasp 0.2451, 9.9 mm left of PS.y 0.255: valid.
+  first_run({0.61, -0.2951, 0.25}, {0.45, -0.305, 0.10});
+  ASSERT_EQ(out.got.size(), 2u);
+  EXPECT_TRUE(starts_with(out.got[1].reason, "P1_VALID")) << out.got[1].reason;
+  marker_detections_t turned = markers(4500);
+  Eigen::Isometry3d t = pose_to_isometry(turned.markers[0].pose_in_base);
+  t.linear() = Eigen::AngleAxisd(-0.002, Eigen::Vector3d::UnitZ()).toRotationMatrix() * t.linear();
+  turned.markers[0].pose_in_base = isometry_to_pose(t, "base", "cart", 4500);
+  send("MARKERS", turned);
+  // P2 base y -0.290: 15 mm left of PS.
+  corner_converged(5000, 2, 0, {0.45, -0.290, 0.26});
+  ASSERT_EQ(out.got.size(), 3u);
+  const grasp_point_t& d = out.got[2];
+  ASSERT_LT(d.p1_grasp[1] - d.ps_grasp[1], -0.0101) << "the turned frame puts P1 beyond the 10 mm tolerance now";
+  EXPECT_TRUE(starts_with(d.reason, "P1_LED_ASTRAY: P2 is 15.")) << d.reason;
+  EXPECT_TRUE(d.p1_used);
+  bool noted = false;
+  for (const auto& st : d.steps)
+    noted |= st.decision.find("-9.9 mm from PS as when BwH started from it") != std::string::npos;
+  EXPECT_TRUE(noted) << "the P1 step says which distance it judged";
 }
 
 // A tall right-most book: P1 failed the PS check, BwH from PS at the stripe's height centred the shorter left
@@ -734,7 +763,8 @@ TEST_F(ArbiterNodeTest, SameInputsGiveTheSameOutputsBitForBit) {
     pub("SERVO_REQUEST", request(3000, 1, servo_request_t::STRIPE_END));
     pub("SERVO_STATUS", status(4000, 1, servo_request_t::STRIPE_END, servo_status_t::CONVERGED, {0.45, -0.305, 0.10}));
     pub("SERVO_REQUEST", request(5000, 2, servo_request_t::BOOK_CORNER, 0));
-    pub("SERVO_STATUS", status(6000, 2, servo_request_t::BOOK_CORNER, servo_status_t::CONVERGED, {0.45, -0.31, 0.26}, 0.02));
+    pub("SERVO_STATUS",
+        status(6000, 2, servo_request_t::BOOK_CORNER, servo_status_t::CONVERGED, {0.45, -0.31, 0.26}, 0.02));
     for (const auto& g : col.got) {
       std::vector<uint8_t> buf(g.getEncodedSize());
       g.encode(buf.data(), 0, static_cast<int>(buf.size()));

@@ -353,6 +353,41 @@ TEST(CombinationStrategy, P1ValidityBoundaryAndTrace) {
   EXPECT_DOUBLE_EQ(r.steps[0].tolerance, 0.01);
 }
 
+// The decision judges P1 on P1.y - PS.y as the check that started BwH measured it, not as the frame moved since
+// (far_cart seed 5021: 9.9 mm at the check, past 10 mm at the decision): both ways, and the step says so.
+TEST(CombinationStrategy, P1IsJudgedOnTheDistanceTheCheckThatStartedBwhMeasured) {
+  CombinationInputs in;
+  in.ps = kPs;
+  in.front_z_fallback = 0.42;
+  in.p1 = V(0.1, 0.100 - 0.0101, 0.4);  // 10.1 mm left of PS now
+  in.p1_ps_dy_at_bwh_start = -0.0099;   // 9.9 mm at the check
+  CombinationResult r = validate_p1(in, kTol);
+  EXPECT_TRUE(r.p1_valid);
+  ASSERT_EQ(r.steps.size(), 1u);
+  EXPECT_NEAR(r.steps[0].value, -0.0099, 1e-12);
+  EXPECT_NE(r.steps[0].decision.find("(P1 -9.9 mm from PS as when BwH started from it; now -10.1 mm)"),
+            std::string::npos)
+      << r.steps[0].decision;
+  // The whole decision too: P2 at P1's corner is grasped with GP.z = P1.z.
+  in.p2 = V(0.1, 0.0899, 0.45);
+  r = combine(in, kTol);
+  EXPECT_EQ(r.outcome, GraspOutcome::kGrasp);
+  EXPECT_TRUE(r.p1_valid);
+  EXPECT_DOUBLE_EQ(r.gp.z(), 0.4);
+  // The other way: invalid at the check, within the tolerance now: still invalid, BwH's start is PS.
+  in.p2.reset();
+  in.p1 = V(0.1, 0.100 - 0.0099, 0.4);
+  in.p1_ps_dy_at_bwh_start = -0.0101;
+  r = validate_p1(in, kTol);
+  EXPECT_FALSE(r.p1_valid);
+  EXPECT_DOUBLE_EQ(r.bwh_start.y(), kPs.y());
+  // Equal to the distance now: no note.
+  in.p1_ps_dy_at_bwh_start = -0.0099;
+  r = validate_p1(in, kTol);
+  EXPECT_TRUE(r.p1_valid);
+  EXPECT_EQ(r.steps[0].decision.find("as when BwH started"), std::string::npos) << r.steps[0].decision;
+}
+
 TEST(CombinationStrategy, AP2FarLeftOfAMeasuredPsIsTheNeighbourP1LedBwhTo) {
   // A 12 mm right-most book, short, beside a taller one: the stripe servo measured PS at its right edge (Y 0.100);
   // BwS's P1 lay on the taller book 7 mm left (valid: within 10 mm of PS); BwH went from P1 to the taller book's
