@@ -52,9 +52,7 @@ validation_step_t to_msg(const ValidationStep& s, int64_t utime) {
   return m;
 }
 
-bool finite3(const double (&v)[3]) {
-  return std::isfinite(v[0]) && std::isfinite(v[1]) && std::isfinite(v[2]);
-}
+bool finite3(const double (&v)[3]) { return std::isfinite(v[0]) && std::isfinite(v[1]) && std::isfinite(v[2]); }
 
 }  // namespace
 
@@ -138,12 +136,8 @@ ArbiterNode::ArbiterNode(const std::string& service, const std::string& implemen
   subscribe(s_.channels.detector_switch, &ArbiterNode::on_switch);
 }
 
-Eigen::Vector3d ArbiterNode::to_grasp(const Eigen::Vector3d& p_base) const {
-  return frame_->inverse() * p_base;
-}
-Eigen::Vector3d ArbiterNode::to_base(const Eigen::Vector3d& p_grasp) const {
-  return *frame_ * p_grasp;
-}
+Eigen::Vector3d ArbiterNode::to_grasp(const Eigen::Vector3d& p_base) const { return frame_->inverse() * p_base; }
+Eigen::Vector3d ArbiterNode::to_base(const Eigen::Vector3d& p_grasp) const { return *frame_ * p_grasp; }
 
 void ArbiterNode::open_attempt() {
   frozen_ = false;
@@ -156,8 +150,7 @@ void ArbiterNode::on_markers(const marker_detections_t& msg) {
   for (const marker_t& m : msg.markers) {
     if (m.role != s_.cart_marker_role) continue;
     if (!is_valid_pose(m.pose_in_base)) {
-      reject(s_.channels.markers,
-             "cart marker " + std::to_string(m.id) + " has an invalid pose_in_base (NaN or not a unit quaternion)");
+      reject(s_.channels.markers, "cart marker " + std::to_string(m.id) + " has an invalid pose_in_base (NaN or not a unit quaternion)");
       return;
     }
     const Eigen::Isometry3d t = pose_to_isometry(m.pose_in_base);
@@ -191,8 +184,8 @@ void ArbiterNode::on_switch(const detector_switch_t& msg) {
     have_p1_msg_ = false;
   }
   // Visible in SERVICE_STATUS.last_error (the runtime has no other free-text field).
-  report_error("detector switch: now following " + s_.follow_logical_channel + " implementation '" + follow_ + "', " +
-               switch_note_);
+  report_error("detector switch: now following " + s_.follow_logical_channel + " implementation '" + follow_ +
+               "', " + switch_note_);
 }
 
 void ArbiterNode::on_book_corner(const book_corner_stereo_t& msg) {
@@ -385,8 +378,7 @@ void ArbiterNode::decide(const servo_status_t& msg) {
       if (use_slope) rot = rot * Eigen::AngleAxisd(slope, Eigen::Vector3d::UnitZ()).toRotationMatrix();
       r.steps.push_back({"GP slope", slope, s_.max_slope_rad, use_slope || !s_.align_with_book_slope,
                          !s_.align_with_book_slope ? "GP keeps the grasp-frame orientation (alignment off)"
-                         : use_slope
-                             ? "gripper aligned with the book slope from BwH"
+                         : use_slope ? "gripper aligned with the book slope from BwH"
                                      : "servo slope beyond gp.max_slope_deg: not trusted, grasp-frame orientation kept"});
       Eigen::Isometry3d gp = Eigen::Isometry3d::Identity();
       gp.linear() = rot;

@@ -29,18 +29,15 @@ CombinationResult fail(CombinationResult r, const std::string& rule, const std::
 
 std::string outcome_name(GraspOutcome o) {
   switch (o) {
-    case GraspOutcome::kGrasp:
-      return "GRASP";
-    case GraspOutcome::kNextRegion:
-      return "NEXT_REGION";
+    case GraspOutcome::kGrasp: return "GRASP";
+    case GraspOutcome::kNextRegion: return "NEXT_REGION";
     case GraspOutcome::kP1LedAstray:
       return "P1_LED_ASTRAY";
     case GraspOutcome::kRaiseBwhStart:
       return "RAISE_BWH_START";
     case GraspOutcome::kStartFromP1:
       return "START_FROM_P1";
-    case GraspOutcome::kNoGrasp:
-      return "NO_GRASP";
+    case GraspOutcome::kNoGrasp: return "NO_GRASP";
   }
   return "?";
 }
@@ -87,8 +84,7 @@ CombinationResult validate_p1_against_ps(const CombinationInputs& in, const Comb
     return r;
   }
   if (!in.p1->allFinite()) {
-    r.steps.push_back(
-        step("P1.y vs PS.y", NAN, tol.p1_ps_y, false, "P1 is not finite: ignore BwS, BwH starts from PS"));
+    r.steps.push_back(step("P1.y vs PS.y", NAN, tol.p1_ps_y, false, "P1 is not finite: ignore BwS, BwH starts from PS"));
     return r;
   }
   const double now = in.p1->y() - in.ps.y();
@@ -128,8 +124,7 @@ CombinationResult validate_p1_against_ps(const CombinationInputs& in, const Comb
     }
   } else {
     r.steps.push_back(step("P1.y vs PS.y", d, tol.p1_ps_y, false,
-                           "P1 invalid (" + mm(d) +
-                               " from PS, e.g. a thin book BwS missed): ignore BwS, BwH "
+                           "P1 invalid (" + mm(d) + " from PS, e.g. a thin book BwS missed): ignore BwS, BwH "
                            "starts from PS"));
   }
   return r;
@@ -286,8 +281,7 @@ CombinationResult combine(const CombinationInputs& in, const CombinationToleranc
     r.steps.push_back(step("P2.y vs " + ref_name + ".y", dy, tol.y, true, "P2.y valid: within the Y tolerance"));
   } else if (dy < 0) {
     r.steps.push_back(step("P2.y vs " + ref_name + ".y", dy, tol.y, true,
-                           "P2.y valid: " + ref_name +
-                               " lies right of P2 and BwH already delivered the right-most "
+                           "P2.y valid: " + ref_name + " lies right of P2 and BwH already delivered the right-most "
                            "region"));
   } else if (!r.p1_valid && tol.p1_p2_agreement_over_ps && in.p1 && in.p1->allFinite() &&
              std::abs(p2.y() - in.p1->y()) < tol.y) {
@@ -360,9 +354,9 @@ ValidationStep check_book_width(double width, const BookSizeLimits& limits) {
                 "book wider than S_max = L_max/2 - TCP offset (" + mm(limits.s_max()) +
                     "): the open left plate lands on the book itself");
   if (width < limits.s_min())
-    return step(
-        "book width >= S_min", width, limits.s_min(), false,
-        "book thinner than S_min = S_max/2 (" + mm(limits.s_min()) + "): the left plate may reach the book after next");
+    return step("book width >= S_min", width, limits.s_min(), false,
+                "book thinner than S_min = S_max/2 (" + mm(limits.s_min()) +
+                    "): the left plate may reach the book after next");
   return step("S_min <= book width <= S_max", width, limits.s_max(), true, "admissible book width " + mm(width));
 }
 

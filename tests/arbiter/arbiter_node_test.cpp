@@ -122,9 +122,7 @@ void expect_vec(const double (&v)[3], const Eigen::Vector3d& want, const char* w
   for (int i = 0; i < 3; ++i) EXPECT_NEAR(v[i], want[i], kTol) << what << "[" << i << "]";
 }
 
-bool starts_with(const std::string& s, const std::string& p) {
-  return s.rfind(p, 0) == 0;
-}
+bool starts_with(const std::string& s, const std::string& p) { return s.rfind(p, 0) == 0; }
 
 class ArbiterNodeTest : public testing::Test {
  protected:
@@ -763,8 +761,7 @@ TEST_F(ArbiterNodeTest, SameInputsGiveTheSameOutputsBitForBit) {
     pub("SERVO_REQUEST", request(3000, 1, servo_request_t::STRIPE_END));
     pub("SERVO_STATUS", status(4000, 1, servo_request_t::STRIPE_END, servo_status_t::CONVERGED, {0.45, -0.305, 0.10}));
     pub("SERVO_REQUEST", request(5000, 2, servo_request_t::BOOK_CORNER, 0));
-    pub("SERVO_STATUS",
-        status(6000, 2, servo_request_t::BOOK_CORNER, servo_status_t::CONVERGED, {0.45, -0.31, 0.26}, 0.02));
+    pub("SERVO_STATUS", status(6000, 2, servo_request_t::BOOK_CORNER, servo_status_t::CONVERGED, {0.45, -0.31, 0.26}, 0.02));
     for (const auto& g : col.got) {
       std::vector<uint8_t> buf(g.getEncodedSize());
       g.encode(buf.data(), 0, static_cast<int>(buf.size()));
