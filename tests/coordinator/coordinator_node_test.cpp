@@ -156,8 +156,8 @@ TEST_F(CoordinatorNodeTest, ParksPlansToTheStripeStartPersistsAndResumes) {
   send("ARM_STATE", arm(1100000, arm_state_t::IDLE, cmd));
   EXPECT_EQ(status.got.back().state, "WAIT_P1_CHECK");
 
-  // The arbiter has no PS: plan to the stripe servo's start A = grasp (0.10, 0.30, -0.07) (coordinator.yaml)
-  // -> base (0.60 - 0.07, -0.05 - 0.30, 0.10) = (0.53, -0.35, 0.10), gripper axes = grasp axes.
+  // The arbiter has no PS: plan to the stripe servo's start A = grasp (0.10, 0.36, -0.07) (coordinator.yaml)
+  // -> base (0.60 - 0.07, -0.05 - 0.36, 0.10) = (0.53, -0.41, 0.10), gripper axes = grasp axes.
   grasp_point_t need;
   need.utime = 1200000;
   need.request_id = 0;
@@ -173,7 +173,7 @@ TEST_F(CoordinatorNodeTest, ParksPlansToTheStripeStartPersistsAndResumes) {
   const plan_request_t& a = plans.got[1];
   EXPECT_EQ(a.goal_type, plan_request_t::POSE);
   EXPECT_NEAR(a.goal_pose.position[0], 0.53, 1e-9);
-  EXPECT_NEAR(a.goal_pose.position[1], -0.35, 1e-9);
+  EXPECT_NEAR(a.goal_pose.position[1], -0.41, 1e-9);
   EXPECT_NEAR(a.goal_pose.position[2], 0.10, 1e-9);
   const Eigen::Matrix3d r = pose_to_isometry(a.goal_pose).linear();
   EXPECT_TRUE(r.isApprox(bookgrasp_test::hand_grasp_frame().linear(), 1e-9)) << r;

@@ -778,8 +778,8 @@ TEST(LibraryCycle, BadDepthKeysNameTheKey) {
        {std::tuple<std::string, std::string, std::string>{"grasp.deep_front_z_m", "deep_front_z_m: 0.035",
                                                           "deep_front_z_m: 0.9"},
         {"servo.book_front_z_m", "book_front_z_m: 0.01", "book_front_z_m: 0.5"},
-        // Right of position A (Y 0.30): the servo would stop before it starts.
-        {"servo.stripe_left_limit_y_m", "stripe_left_limit_y_m: -0.15", "stripe_left_limit_y_m: 0.35"},
+        // Right of position A (Y 0.36): the servo would stop before it starts.
+        {"servo.stripe_left_limit_y_m", "stripe_left_limit_y_m: -0.15", "stripe_left_limit_y_m: 0.38"},
         {"limit_stop_place_m", "limit_stop_place_m: 0.02", "limit_stop_place_m: 0.2"},
         // The plate-distance check: 0 would leave the retry as wide as the grasp.
         {"grasp.retry_left_clearance_m", "retry_left_clearance_m: 0.005", "retry_left_clearance_m: 0.0"},

@@ -127,7 +127,9 @@ namespace {
 // on seed 5 (bookgrasp_eval_full --scenes 1 --seed 5 --scene config/scenes/default.yaml --books 3 --stereo-hz 2
 // --log --log-channels BOOK_CORNER_STEREO,SERVO_STATUS,SERVO_REQUEST,MARKERS,ARM_STATE,DETECTOR_SWITCH,GRASP_POINT
 // --out DIR, then DIR/logs/seed_5.lcmlog: three books through the whole cycle (stop 27); at first two, the third
-// ABORTED when the corner servo stopped at a joint limit); re-recorded 2026-12-05 (stop 28) when the arbiter began
+// ABORTED when the corner servo stopped at a joint limit); re-recorded 2026-12-07 (stop 43) when an attempt's P1 came
+// to be judged on the distance its P1 check measured (three grasps held: two books moved, the third handed over);
+// re-recorded 2026-12-05 (stop 28) when the arbiter began
 // to check P2 against a PS the stripe servo measured (tolerances.p2_measured_ps_y_m, one more step in GRASP);
 // re-recorded 2026-12-04 (stop 27) when the cart tag moved 0.10 m right (scene markers.cart.y_m 0.20); re-recorded
 // 2026-12-04 (stop 26) when the arbiter began to read the book width only while the arm executes no motion (three books
