@@ -73,6 +73,12 @@ std::optional<double> front_depth_without_p1(const CombinationInputs& in, const 
 
 namespace {
 
+// P1.y - PS.y as the decision judges it: the check's when BwH started from it (CombinationInputs::
+// p1_ps_dy_at_bwh_start), else from p1 and ps. `in.p1` must be set.
+double p1_ps_dy(const CombinationInputs& in) {
+  return in.p1_ps_dy_at_bwh_start.value_or(in.p1->y() - in.ps.y());
+}
+
 // Section 3.1 as the paper writes it (with P1_LED_ASTRAY's exception).
 CombinationResult validate_p1_against_ps(const CombinationInputs& in, const CombinationTolerances& tol) {
   CombinationResult r;
@@ -87,8 +93,7 @@ CombinationResult validate_p1_against_ps(const CombinationInputs& in, const Comb
     r.steps.push_back(step("P1.y vs PS.y", NAN, tol.p1_ps_y, false, "P1 is not finite: ignore BwS, BwH starts from PS"));
     return r;
   }
-  const double now = in.p1->y() - in.ps.y();
-  const double d = in.p1_ps_dy_at_bwh_start.value_or(now);
+  const double d = p1_ps_dy(in);
   if (in.p1_led_astray) {
     r.steps.push_back(step("P1 led BwH astray", d, tol.p1_ps_y, false,
                            "P1 (" + mm(d) +
@@ -258,13 +263,12 @@ CombinationResult combine(const CombinationInputs& in, const CombinationToleranc
   // START_FROM_P1; from that P1 (p1_between) such a P2 again gets no grasp. With a measured PS the rule above has
   // answered already (P2 would lie more than y + p1_ps_y left of PS).
   if (tol.invalid_p1_over_p2 && (!r.p1_valid || in.p1_between) && in.p1 && in.p1->allFinite() &&
-      in.p1->y() - in.ps.y() < -tol.p1_ps_y) {
+      p1_ps_dy(in) < -tol.p1_ps_y) {
     const double dy1 = p2.y() - in.p1->y();
     const double dx1 = p2.x() - in.p1->x();
     if (dy1 <= -tol.y && dx1 <= -tol.x) {
       std::string why = "P2 is " + mm(-dy1) + " left of and " + mm(-dx1) + " below the P1 that lies " +
-                        mm(in.ps.y() - in.p1->y()) +
-                        " left of PS: P1's book stands between, P2 is a neighbour's corner";
+                        mm(-p1_ps_dy(in)) + " left of PS: P1's book stands between, P2 is a neighbour's corner";
       if (in.p1_between) {
         r.outcome = GraspOutcome::kNoGrasp;
         why += " (BwH from P1 too): no grasp";
