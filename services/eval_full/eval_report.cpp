@@ -194,6 +194,13 @@ void write_report(const std::string& dir, const EvalMetrics& m, const std::strin
   md << "## Failure modes\n\n";
   if (m.failure_modes.empty()) md << "None.\n";
   for (const auto& [why, n] : m.failure_modes) md << "- " << n << " x " << why << "\n";
+  md << "\n## Short of the aims, by seed (scenes; re-run one alone with `--scenes 1 --seed <seed>`)\n\n";
+  if (m.shortfall_seeds.empty()) md << "None.\n";
+  for (const auto& [kind, seeds] : m.shortfall_seeds) {
+    md << "- " << kind << " (" << seeds.size() << "):";
+    for (uint64_t s : seeds) md << " " << s;
+    md << "\n";
+  }
   md << "\n## Failures (re-run one alone with `--scenes 1 --seed <seed>`)\n\n";
   if (m.failures.empty()) md << "None.\n";
   for (const auto& [seed, why] : m.failures) md << "- seed " << seed << ": " << why << "\n";

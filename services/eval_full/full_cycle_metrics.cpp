@@ -150,8 +150,26 @@ int disagreement_mode(const GraspDecisionRecord& d, const MetricTolerances& tol)
   return 3;
 }
 
+std::map<std::string, int> shortfall_counts(const EvalMetrics& m) {
+  int classified = 0;
+  for (int n : m.p1_p2_disagreements) classified += n;
+  std::map<std::string, int> all = {
+      {"grasp_not_held_alone", m.grasp_attempts - m.grasp_successes},
+      {"untargeted_book_off_the_upper_shelf", m.untargeted_books_off_the_upper_shelf},
+      {"p1_p2_unclassified", m.decisions - m.decisions_agreeing - classified},
+      {"width_off_by_more_than_1cm", m.widths - m.widths_within},
+      {"stripe_end_outside_tolerance", m.stripes - m.stripes_within},
+  };
+  for (int k = 0; k < 4; ++k) all[std::string("p1_p2_") + kDisagreementModes[k]] = m.p1_p2_disagreements[k];
+  std::map<std::string, int> out;
+  for (const auto& [kind, n] : all)
+    if (n > 0) out[kind] = n;
+  return out;
+}
+
 void accumulate(const SceneOutcome& o, int max_books, const MetricTolerances& tol, EvalMetrics* m) {
   const FullCycleResult& r = o.result;
+  const std::map<std::string, int> short_before = shortfall_counts(*m);
   ++m->scenes;
   m->scene_wall_s.push_back(r.wall_s);
   const int targeted = max_books > 0 ? std::min(max_books, r.books_on_upper_shelf) : r.books_on_upper_shelf;
@@ -221,6 +239,13 @@ void accumulate(const SceneOutcome& o, int max_books, const MetricTolerances& to
   if (!why.empty()) {
     m->failures.emplace_back(o.seed, why);
     ++m->failure_modes[why];
+  }
+  for (const auto& [kind, n] : shortfall_counts(*m)) {
+    const auto before = short_before.find(kind);
+    if (n <= (before == short_before.end() ? 0 : before->second)) continue;
+    std::vector<uint64_t>& seeds = m->shortfall_seeds[kind];
+    const auto at = std::lower_bound(seeds.begin(), seeds.end(), o.seed);
+    if (at == seeds.end() || *at != o.seed) seeds.insert(at, o.seed);
   }
 }
 
@@ -319,6 +344,15 @@ std::string metrics_json(const EvalMetrics& m, const std::string& command) {
   bool first = true;
   for (const auto& [k, v] : m.failure_modes) {
     j << (first ? "" : ", ") << "\"" << esc(k) << "\": " << v;
+    first = false;
+  }
+  j << "},\n";
+  j << "  \"shortfall_seeds\": {";
+  first = true;
+  for (const auto& [kind, seeds] : m.shortfall_seeds) {
+    j << (first ? "" : ", ") << "\"" << esc(kind) << "\": [";
+    for (size_t i = 0; i < seeds.size(); ++i) j << (i ? ", " : "") << seeds[i];
+    j << "]";
     first = false;
   }
   j << "},\n";

@@ -98,7 +98,16 @@ struct EvalMetrics {
   std::vector<double> scene_wall_s;          ///< wall time per scene
   std::vector<std::pair<uint64_t, std::string>> failures;  ///< seed, reason
   std::map<std::string, int> failure_modes;  ///< reason class -> count
+  /// The scenes (seeds, sorted, once each) that fell short in each kind of shortfall_counts: which to re-run alone.
+  /// Scene records do not store it: a record is one scene, so its counts give its kinds (parse_scene_record).
+  std::map<std::string, std::vector<uint64_t>> shortfall_seeds;
 };
+
+/// What fell short of the evaluation's aims (grasps that held the target alone, P1-P2 agreement, width within 1 cm)
+/// and of the paper's stripe end tolerance in `m`, counted from its counts by kind: "grasp_not_held_alone",
+/// "untargeted_book_off_the_upper_shelf", "p1_p2_" + each of kDisagreementModes, "p1_p2_unclassified" (disagreeing
+/// without a P1 truth), "width_off_by_more_than_1cm", "stripe_end_outside_tolerance". Kinds with none are left out.
+std::map<std::string, int> shortfall_counts(const EvalMetrics& m);
 
 /// Where the simulation's truth has book `b` at the end of the scene ("unknown" if it has no such book).
 std::string final_place(const FullCycleResult& r, const BookRecord& b);

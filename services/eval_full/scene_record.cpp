@@ -140,6 +140,7 @@ SceneRecord parse_scene_record(const std::string& text, const std::string& where
                                       required(f, "reason", where).as<std::string>());
     for (const auto& kv : required(n, "failure_modes", where))
       r.metrics.failure_modes[kv.first.as<std::string>()] = kv.second.as<int>();
+    for (const auto& [kind, n] : shortfall_counts(r.metrics)) r.metrics.shortfall_seeds[kind] = {r.seed};
   } catch (const YAML::Exception& e) {
     throw std::runtime_error(where + ": " + e.what());
   }
@@ -194,6 +195,12 @@ void add_metrics(const EvalMetrics& from, EvalMetrics* into) {
   std::stable_sort(into->failures.begin(), into->failures.end(),
                    [](const auto& a, const auto& b) { return a.first < b.first; });
   for (const auto& [why, n] : from.failure_modes) into->failure_modes[why] += n;
+  for (const auto& [kind, seeds] : from.shortfall_seeds) {
+    std::vector<uint64_t>& all = into->shortfall_seeds[kind];
+    all.insert(all.end(), seeds.begin(), seeds.end());
+    std::sort(all.begin(), all.end());
+    all.erase(std::unique(all.begin(), all.end()), all.end());
+  }
 }
 
 }  // namespace bookgrasp

@@ -40,7 +40,7 @@ std::map<uint64_t, SceneRecord> read_scene_records(const std::string& dir);
 std::map<uint64_t, SceneRecord> merged_scene_records(const std::vector<std::string>& dirs);
 
 /// Adds `from`'s counts and samples to `into`: the same figures as accumulating both sets of scenes into one, when
-/// `from`'s scenes come after `into`'s. Failures stay sorted by seed.
+/// `from`'s scenes come after `into`'s. Failures and the seeds of each shortfall stay sorted by seed.
 void add_metrics(const EvalMetrics& from, EvalMetrics* into);
 
 }  // namespace bookgrasp

@@ -112,3 +112,19 @@ TEST(EvalReport, TheBooksPassedOverHaveTheirRow) {
   const std::string report = report_text(dir);
   EXPECT_NE(report.find("passed over for the right-most standing book | 3 |"), std::string::npos) << report;
 }
+
+TEST(EvalReport, TheScenesShortOfTheAimsAreListedWithTheirSeeds) {
+  const std::string dir = testing::TempDir() + "/eval_report_shortfalls";
+  ASSERT_EQ(std::system(("mkdir -p " + dir).c_str()), 0);
+  EvalMetrics m = half_upright();
+  m.shortfall_seeds["p1_p2_p1_below_corner"] = {5006, 5027};
+  write_report(dir, m, "test", 0);
+  std::string report = report_text(dir);
+  EXPECT_NE(report.find("## Short of the aims, by seed"), std::string::npos) << report;
+  EXPECT_NE(report.find("- p1_p2_p1_below_corner (2): 5006 5027\n"), std::string::npos) << report;
+  write_report(dir, half_upright(), "test", 0);
+  report = report_text(dir);
+  EXPECT_NE(report.find("by seed (scenes; re-run one alone with `--scenes 1 --seed <seed>`)\n\nNone.\n"),
+            std::string::npos)
+      << report;
+}

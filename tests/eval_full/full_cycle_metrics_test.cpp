@@ -371,3 +371,32 @@ TEST(FullCycleMetrics, DisagreementsAreNamedByWhereP1LayAgainstTheTrueCorner) {
                                       "\"p1_below_corner\": 1, \"p2_off_p1_near_corner\": 0}"),
             std::string::npos);
 }
+
+TEST(FullCycleMetrics, TheScenesShortOfTheAimsAreListedByKindWithTheirSeeds) {
+  // done_scene: 3 grasp attempts, 2 held; one width 15 mm off; one decision whose P1 is 4 mm from the true corner and
+  // whose P2 is 20 mm off in Y. Seed 6 also has a stripe end 16 mm off in X. Seed 5 is made clean.
+  SceneOutcome clean = done_scene(5);
+  clean.result.grasp_attempts = 2;
+  clean.result.books[1].measured_width_m = 0.021;
+  clean.result.decisions.erase(clean.result.decisions.begin() + 1);
+  SceneOutcome stripe_off = done_scene(6);
+  const Eigen::Vector3d end(0.30, 0.12, 0.40);
+  stripe_off.result.stripes = {{0, end + Eigen::Vector3d(0.016, 0.0, -0.46), end},
+                               {1, end + Eigen::Vector3d(0.0, 0.011, -0.46), end}};
+  EvalMetrics m;
+  for (const SceneOutcome& o : {done_scene(9), clean, stripe_off, done_scene(7)})
+    accumulate(o, 0, MetricTolerances{}, &m);
+  const std::vector<uint64_t> three = {6, 7, 9};
+  EXPECT_EQ(m.shortfall_seeds.size(), 4u);
+  EXPECT_EQ(m.shortfall_seeds["grasp_not_held_alone"], three);
+  EXPECT_EQ(m.shortfall_seeds["width_off_by_more_than_1cm"], three);
+  EXPECT_EQ(m.shortfall_seeds["p1_p2_p2_off_p1_near_corner"], three);
+  // Two stripe ends off in one scene: the seed once.
+  EXPECT_EQ(m.shortfall_seeds["stripe_end_outside_tolerance"], std::vector<uint64_t>{6});
+  const std::map<std::string, int> counts = shortfall_counts(m);
+  EXPECT_EQ(counts.at("grasp_not_held_alone"), 3);
+  EXPECT_EQ(counts.at("stripe_end_outside_tolerance"), 2);
+  EXPECT_EQ(counts.count("p1_p2_unclassified"), 0u);
+  EXPECT_NE(metrics_json(m, "c").find("\"shortfall_seeds\": {\"grasp_not_held_alone\": [6, 7, 9], "), std::string::npos)
+      << metrics_json(m, "c");
+}

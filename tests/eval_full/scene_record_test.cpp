@@ -179,6 +179,25 @@ TEST(SceneRecord, BooksPassedOverRoundTripAndARecordFromBeforeThemReadsAsNone) {
   EXPECT_EQ(before.metrics.grasp_attempts, r.metrics.grasp_attempts);
 }
 
+TEST(SceneRecord, AScenesShortfallsAreReadFromItsCountsSoOlderRecordsListThemToo) {
+  // The record stores no seeds per shortfall: they come from its counts (the grasp retry, the 15 mm width and the
+  // P2 20 mm off of done_scene).
+  std::string text = scene_record_yaml(record_of(done_scene(21)));
+  ASSERT_EQ(text.find("shortfall"), std::string::npos) << text;
+  const SceneRecord back = parse_scene_record(text, "t");
+  EXPECT_EQ(back.metrics.shortfall_seeds, record_of(done_scene(21)).metrics.shortfall_seeds);
+  const std::vector<uint64_t> seed = {21};
+  EXPECT_EQ(back.metrics.shortfall_seeds.at("grasp_not_held_alone"), seed);
+  EXPECT_EQ(back.metrics.shortfall_seeds.at("width_off_by_more_than_1cm"), seed);
+  EXPECT_EQ(back.metrics.shortfall_seeds.at("p1_p2_p2_off_p1_near_corner"), seed);
+  EXPECT_EQ(back.metrics.shortfall_seeds.size(), 3u);
+  // Merged in any order, each kind's seeds come out sorted.
+  EvalMetrics merged;
+  for (uint64_t s : {30u, 22u, 25u})
+    add_metrics(parse_scene_record(scene_record_yaml(record_of(done_scene(s))), "t").metrics, &merged);
+  EXPECT_EQ(merged.shortfall_seeds.at("grasp_not_held_alone"), (std::vector<uint64_t>{22, 25, 30}));
+}
+
 TEST(SceneRecord, ABadFileIsNamedWithItsKey) {
   std::string text = scene_record_yaml(record_of(done_scene(1)));
   const auto at = text.find("grasp_attempts:");
