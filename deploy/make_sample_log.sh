@@ -8,7 +8,9 @@
 # 20 s at ~25 MB (re-recorded 2026-12-02 on far_cart.yaml for the stereo-ranged markers; 20 s end inside the
 # first stripe servo, so the arbiter is replayed on logs/samples/arbiter_seed5.lcm instead; re-recorded 2026-12-03 for
 # the BwS selection changes of stop 17; re-recorded 2026-12-05 for BwS's top_growth_climbed_only, stop 30, and for
-# GoD's smoothed gradients, stop 34, and for the front layer and the hole budget of stop 35).
+# GoD's smoothed gradients, stop 34, and for the front layer and the hole budget of stop 35; re-recorded 2026-12-07
+# with 35 s for BSwH's colour check, stop 45: with 20 and 25 s the log ended early in the stripe servo, 79 and 48
+# SERVO_STATUS, fewer than the visual servo's replay test needs).
 set -euo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 OUT="$1"; SECONDS_TO_RECORD="${2:-3}"

@@ -33,6 +33,7 @@ StripeDetectionParams StripeDetectionParams::from_config(const Config& cfg) {
   if (cfg.has("min_band_fill")) p.min_band_fill = cfg.get_double("min_band_fill", 0.0, 1.0);
   if (cfg.has("expected_row_px")) p.expected_row_px = cfg.get_double("expected_row_px", -1.0, 10000.0);
   if (cfg.has("max_row_offset_px")) p.max_row_offset_px = cfg.get_double("max_row_offset_px", 1.0, 1e9);
+  if (cfg.has("max_dark_spread")) p.max_dark_spread = cfg.get_int("max_dark_spread", 0, 255);
   if (cfg.has("background_kernel_width_px"))
     p.background_kernel_width_px = cfg.get_int("background_kernel_width_px", 0, 1024);
   return p;
@@ -110,6 +111,20 @@ StripeDetection detect_stripe(const cv::Mat& image, const StripeDetectionParams&
   cv::Mat threshold;
   background.convertTo(threshold, CV_8U, p.dark_ratio);
   cv::Mat dark = (smooth < threshold) & (smooth < p.max_dark_value);
+  if (image.type() == CV_8UC3 && p.max_dark_spread < 255) {
+    // Colour spread of each pixel, smoothed like the value: noise on a black stripe stays a few grey levels.
+    // Only dark coloured areas at least 5 px across count: the rims where the stripe blends into a coloured
+    // background are dark and coloured too, and taking them off would thin the band.
+    cv::Mat ch[3], low, spread;
+    cv::split(image, ch);
+    cv::min(ch[0], ch[1], low);
+    cv::min(low, ch[2], low);
+    cv::subtract(v, low, spread);
+    if (p.blur_sigma_px > 0) cv::GaussianBlur(spread, spread, cv::Size(0, 0), p.blur_sigma_px);
+    cv::Mat coloured = (spread > p.max_dark_spread) & dark;
+    cv::morphologyEx(coloured, coloured, cv::MORPH_OPEN, cv::getStructuringElement(cv::MORPH_RECT, cv::Size(5, 5)));
+    dark &= ~coloured;
+  }
   const int run = std::max(5, std::min(p.min_length_px, 41) / 2 * 2 + 1);
   const int usable_rows = std::max(1, v.rows - p.ignore_bottom_rows);
   if (usable_rows < v.rows) dark.rowRange(usable_rows, v.rows).setTo(0);
@@ -119,7 +134,7 @@ StripeDetection detect_stripe(const cv::Mat& image, const StripeDetectionParams&
   const int n = cv::connectedComponentsWithStats(dark, labels, stats, centroids, 8, CV_32S);
   const double max_tan = std::tan(p.max_angle_deg * CV_PI / 180.0);
   std::vector<Segment> segments;
-  std::string last_reject = "no dark horizontal region at all (dark_ratio, max_dark_value)";
+  std::string last_reject = "no dark horizontal region at all (dark_ratio, max_dark_value, max_dark_spread)";
   for (int i = 1; i < n; ++i) {
     const int bx = stats.at<int>(i, cv::CC_STAT_LEFT), by = stats.at<int>(i, cv::CC_STAT_TOP);
     const int bw = stats.at<int>(i, cv::CC_STAT_WIDTH), bh = stats.at<int>(i, cv::CC_STAT_HEIGHT);

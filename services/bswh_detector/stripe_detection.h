@@ -24,7 +24,11 @@ struct StripeDetectionParams {
   /// standing book's shadow on the rear board, a dark cover) stay in it and are not taken for the stripe.
   int background_kernel_width_px = 0;
   double dark_ratio = 0.5;        ///< a pixel is stripe if value < dark_ratio * local background ...
-  int max_dark_value = 90;        ///< ... and value (max of R, G, B) < this
+  int max_dark_value = 90;        ///< ... and value (max of R, G, B) < this ...
+  /// ... and, in a colour image, not in a dark area (>= 5 px across) where max(R, G, B) - min(R, G, B), smoothed
+  /// as the value, exceeds this: the stripe is a neutral black, so a coloured dark cover's top beside it (a navy
+  /// book's, 20 grey levels apart) is not stripe. 255 = no colour check (grey images always).
+  int max_dark_spread = 255;
   int min_length_px = 40;         ///< shortest visible stripe segment
   double min_thickness_px = 4.0;  ///< stripe thickness range (perpendicular), pixels
   double max_thickness_px = 80.0;

@@ -110,9 +110,12 @@ TEST(StripeDetection, ABooksTallShadowOnTheRearBoardIsNotTheStripe) {
 }
 
 TEST(StripeDetection, WithASquareBackgroundClosingTheBooksShadowIsTakenForTheStripe) {
-  // The earlier behaviour, documenting what the key is for and that the test above can fail.
+  // The earlier behaviour, documenting what the key is for and that the test above can fail. Without the
+  // colour check too (stripe.max_dark_spread, later): it alone also keeps this shadow out, as a shadow on the
+  // brown board stays brown.
   StripeDetectionParams p = params();
   p.background_kernel_width_px = 0;
+  p.max_dark_spread = 255;
   test::SynthTruth truth;
   const cv::Mat img = test::render_scene(book_shadow_scene(), &truth);
   const StripeDetection d = detect_stripe(img, p);
@@ -250,6 +253,29 @@ TEST(StripeDetectionRendered, FarFromTheExpectedRowNothingIsTaken) {
   EXPECT_TRUE(detect_stripe(load_rendered("hand_eval_seed1_converged.png"), shipped_params()).found);
 }
 
+// A whole-cycle hand image (far_cart.yaml seed 5193, the stripe servo 29 s in; `bookgrasp_eval_full --scenes 1
+// --seed 5193 --books 1 --stereo-hz 2 --snapshots --snapshot-period-s 0.5`, the raw PNG): a short navy book whose
+// top face (max(R,G,B) ~33, RGB ~(13, 22, 33)) lies on the stripe's rows (~289-307) right of a taller neighbour.
+// Truth read off the raw pixels: on the stripe's centre row 298 the navy top ends at column 413 and the stripe
+// (max ~5) begins at 414; on rows 292 and 304 the stripe begins at 405 and 424 (the top face's right edge is
+// slanted). The navy top joined the band, and its left end (column ~330) was taken for the stripe's end: the
+// servo chased it for 30 s twice and timed out.
+TEST(StripeDetectionRendered, ANavyCoverTopOnTheStripesRowsIsNotTheStripe) {
+  const cv::Mat img = load_rendered("far_cart_seed5193_navy_book_top.png");
+  ASSERT_FALSE(img.empty());
+  const StripeDetection d = detect_stripe(img, shipped_params());
+  ASSERT_TRUE(d.end_found) << d.failure_reason;
+  EXPECT_GE(d.end.x, 404.0) << "the end is expected where the stripe begins beside the navy top (405-424)";
+  EXPECT_LE(d.end.x, 425.0) << "the end is expected where the stripe begins beside the navy top (405-424)";
+  EXPECT_NEAR(d.centre_y_at(d.end.x), 298.0, 3.0);
+
+  StripeDetectionParams no_colour = shipped_params();
+  no_colour.max_dark_spread = 255;
+  const StripeDetection merged = detect_stripe(img, no_colour);
+  ASSERT_TRUE(merged.end_found) << merged.failure_reason;
+  EXPECT_LT(merged.end.x, 350.0) << "without the colour check the navy top is expected to join the band";
+}
+
 TEST(StripeDetectionConfig, RobustnessKeysAreOptionalAndChecked) {
   const std::string base = std::string(
       "blur_sigma_px: 1.2\nbackground_scale: 8\nbackground_kernel_px: 64\n"
@@ -260,8 +286,12 @@ TEST(StripeDetectionConfig, RobustnessKeysAreOptionalAndChecked) {
   EXPECT_EQ(p.ignore_bottom_rows, 0);
   EXPECT_FALSE(p.reject_touching_bottom);
   EXPECT_LT(p.expected_row_px, 0);
+  EXPECT_EQ(p.max_dark_spread, 255);
+  EXPECT_EQ(
+      StripeDetectionParams::from_config(Config::from_string(base + "max_dark_spread: 12\n", "test")).max_dark_spread,
+      12);
   for (const char* bad : {"min_band_fill: 1.5", "ignore_bottom_rows: -1", "max_row_offset_px: 0", "expected_row_px: -5",
-                          "reject_touching_bottom: maybe"}) {
+                          "reject_touching_bottom: maybe", "max_dark_spread: 300", "max_dark_spread: -1"}) {
     const Config c = Config::from_string(base + bad + "\n", "test");
     EXPECT_THROW(StripeDetectionParams::from_config(c), ConfigError) << bad;
   }
