@@ -556,8 +556,10 @@ PlanOutcome MotionPlanner::plan(const PlanningScene& scene, const PlanRequest& r
   const long max_steps = params_.max_search_steps;
   const ob::PlannerTerminationCondition step_limit(
       [steps, max_steps] { return ++*steps > max_steps && max_steps > 0; });
-  const ob::PlannerStatus status = planner->solve(
-      ob::plannerOrTerminationCondition(step_limit, ob::timedPlannerTerminationCondition(req.time_budget_s)));
+  const ob::PlannerStatus status =
+      planner->solve(params_.wall_clock_stop ? ob::plannerOrTerminationCondition(
+                                                   step_limit, ob::timedPlannerTerminationCondition(req.time_budget_s))
+                                             : step_limit);
   out.search_time_s = elapsed() - search_begin;
   out.search_steps = std::min(*steps, max_steps > 0 ? max_steps : *steps);
   if (status != ob::PlannerStatus::EXACT_SOLUTION || !pdef->hasExactSolution()) {

@@ -82,6 +82,10 @@ struct MotionPlannerParams {
   /// extension), whatever the clock says, so the outcome does not depend on the machine's load; the request's
   /// time budget still applies as a safety stop. 0: the time budget alone decides.
   int max_search_steps = 0;
+  /// true: the request's time_budget_s also ends a search (the safety stop above). false: only
+  /// max_search_steps does (it must then be > 0), so a replay on a slow or busy machine gives the recorded
+  /// answers; a deployed planner keeps it true, so that no request waits longer than its budget.
+  bool wall_clock_stop = true;
   int simplify_shortcuts = 60;             ///< random shortcut attempts
   int goal_ik_solutions = 4;               ///< distinct valid IK solutions used as goals for a pose goal
   int goal_ik_attempts = 24;               ///< IK attempts to find them

@@ -86,6 +86,11 @@ PlannerSettings PlannerSettings::from_config(const Config& root) {
   p.collision_resolution_rad = pl.get_double("collision_resolution_rad", 1e-4, 0.5);
   p.range_rad = pl.get_double("range_rad", 1e-3, 10.0);
   p.max_search_steps = pl.get_int("max_search_steps", 0, 100000000);
+  p.wall_clock_stop = pl.get<bool>("wall_clock_stop");
+  if (!p.wall_clock_stop && p.max_search_steps == 0)
+    throw ConfigError(root.source() + ": " + pl.path_of("wall_clock_stop") + " is false and " +
+                      pl.path_of("max_search_steps") +
+                      " is 0: nothing would end a search; set max_search_steps > 0 or wall_clock_stop: true");
   p.simplify_shortcuts = pl.get_int("simplify_shortcuts", 0, 100000);
   p.goal_ik_solutions = pl.get_int("goal_ik_solutions", 1, 100);
   p.goal_ik_attempts = pl.get_int("goal_ik_attempts", 1, 10000);

@@ -4,7 +4,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <fstream>
 #include <functional>
+#include <regex>
+#include <sstream>
 
 #include <gtest/gtest.h>
 
@@ -27,9 +30,18 @@ Eigen::VectorXd q7(double a, double b, double c, double d, double e, double f, d
   return (Eigen::VectorXd(7) << a, b, c, d, e, f, g).finished();
 }
 
+// The shipped settings with the wall clock out of the search (planner.wall_clock_stop false): the step limit alone
+// ends it, so the tests' outcomes do not depend on how busy the machine is (they failed starved of CPU behind an
+// evaluation). FailureReasons and TheWallClockStopEndsASearchOnlyWhenOn put the clock back where they test it.
+PlannerSettings shipped_settings_without_the_clock() {
+  PlannerSettings s = PlannerSettings::load(kConfig);
+  s.planner.wall_clock_stop = false;
+  return s;
+}
+
 class MotionPlannerTest : public ::testing::Test {
  protected:
-  MotionPlannerTest() : settings_(PlannerSettings::load(kConfig)), stack_(settings_) {
+  MotionPlannerTest() : settings_(shipped_settings_without_the_clock()), stack_(settings_) {
     // A pillar in front of the robot and a floor: start on the left of it, goal on the right.
     scene_ = std::make_unique<PlanningScene>(stack_.scene);
     scene_->set_environment({box("pillar", {0.55, 0.0, 0.1}, {0.2, 0.2, 1.2}), box("floor", {0, 0, -0.6}, {3, 3, 0.1})});
@@ -331,11 +343,14 @@ TEST_F(MotionPlannerTest, FailureReasons) {
   EXPECT_NE(r.message.find("with pillar ("), std::string::npos) << r.message;
 
   // The pillar blocks the straight line, so no planner can answer within a microsecond.
+  MotionPlannerParams clocked_params = stack_.planner.params();
+  clocked_params.wall_clock_stop = true;
+  const MotionPlanner clocked(stack_.planner.ik(), clocked_params);
   for (const std::string name : {"CellBiRRT", "RRTConnect", "BiTRRT"}) {
     PlanRequest rushed = req;
     rushed.planner = name;
     rushed.time_budget_s = 1e-6;
-    r = stack_.planner.plan(*scene_, rushed);
+    r = clocked.plan(*scene_, rushed);
     EXPECT_EQ(r.failure, PlanFailure::kTimeout) << name << ": " << r.message;
   }
   PlanRequest budget = req;
@@ -374,6 +389,52 @@ TEST_F(MotionPlannerTest, TheSearchStepLimitDecidesNotTheClock) {
   EXPECT_EQ(a.search_steps, b.search_steps);
   ASSERT_EQ(a.path.size(), b.path.size());
   for (size_t i = 0; i < a.path.size(); ++i) EXPECT_TRUE(a.path[i].isApprox(b.path[i], 0.0)) << "waypoint " << i;
+}
+
+TEST_F(MotionPlannerTest, TheWallClockStopEndsASearchOnlyWhenOn) {
+  // Around the pillar within a microsecond: the shipped planner (wall_clock_stop true) gives up, saying the
+  // budget; with the clock off the step limit alone ends the search, and the path is found.
+  MotionPlannerParams on = stack_.planner.params();
+  on.wall_clock_stop = true;
+  MotionPlannerParams off = on;
+  off.wall_clock_stop = false;
+  ASSERT_GT(off.max_search_steps, 0) << "config/services/planner.yaml must limit the steps";
+  PlanRequest req;
+  req.start = start_;
+  req.goal_joints = goal_;
+  req.time_budget_s = 1e-6;
+  req.seed = 3;
+  const PlanOutcome rushed = MotionPlanner(stack_.planner.ik(), on).plan(*scene_, req);
+  EXPECT_EQ(rushed.failure, PlanFailure::kTimeout) << rushed.message;
+  EXPECT_NE(rushed.message.find("the time budget of"), std::string::npos) << rushed.message;
+  const PlanOutcome stepped = MotionPlanner(stack_.planner.ik(), off).plan(*scene_, req);
+  ASSERT_TRUE(stepped.success) << stepped.message;
+  expect_collision_free(*scene_, stepped);
+  EXPECT_GT(stepped.search_time_s, req.time_budget_s);
+}
+
+TEST(PlannerSettingsTest, NoWallClockStopNeedsAStepLimit) {
+  std::ifstream in(kConfig);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  const std::string shipped = ss.str();
+  const auto with = [&](const std::string& pattern, const std::string& replacement, const std::string& text) {
+    const std::string changed = std::regex_replace(text, std::regex(pattern), replacement);
+    EXPECT_NE(changed, text) << pattern << " is not in planner.yaml";
+    return changed;
+  };
+  const std::string off = with("wall_clock_stop: true", "wall_clock_stop: false", shipped);
+  EXPECT_FALSE(PlannerSettings::from_config(Config::from_string(off, "off.yaml")).planner.wall_clock_stop);
+  const std::string neither = with("max_search_steps: [0-9]+", "max_search_steps: 0", off);
+  try {
+    PlannerSettings::from_config(Config::from_string(neither, "neither.yaml"));
+    ADD_FAILURE() << "no step limit and no wall clock must be refused";
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("planner.wall_clock_stop"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("max_search_steps"), std::string::npos) << e.what();
+  }
+  const std::string missing = with("  wall_clock_stop: true[^\n]*\n", "", shipped);
+  EXPECT_THROW(PlannerSettings::from_config(Config::from_string(missing, "missing.yaml")), ConfigError);
 }
 
 TEST_F(MotionPlannerTest, AStartWithinTheMarginIsLeftStraightFirst) {

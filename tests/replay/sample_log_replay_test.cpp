@@ -6,9 +6,13 @@
 
 #include <fstream>
 #include <regex>
+#include <sstream>
+#include <utility>
+#include <vector>
 
 #include "bookgrasp/arm_command_t.hpp"
 #include "bookgrasp/plan_result_t.hpp"
+#include "services/planner/planner_config.h"
 #include "services/replay/component_registry.h"
 #include "services/replay/output_diff.h"
 #include "services/replay/replay_runner.h"
@@ -22,16 +26,27 @@ const std::set<std::string> kTiming = {"processing_ms", "disparity_ms", "segment
 
 // config/services/<service>.yaml with `pattern` replaced by `replacement`, written to TempDir()/<file>; "" when the
 // replacement changed nothing (the shipped file no longer has the pattern).
-std::string shipped_config_with(const std::string& service, const std::string& pattern, const std::string& replacement,
+// config/services/<service>.yaml with every (pattern, replacement) applied in order, written to the test's temporary
+// directory as `file`; "" when some pattern is not in the text it is applied to.
+std::string shipped_config_with(const std::string& service,
+                                const std::vector<std::pair<std::string, std::string>>& replacements,
                                 const std::string& file) {
   std::ifstream in(std::string(BOOKGRASP_SOURCE_DIR) + "/config/services/" + service + ".yaml");
   std::stringstream ss;
   ss << in.rdbuf();
-  const std::string changed = std::regex_replace(ss.str(), std::regex(pattern), replacement);
-  if (changed == ss.str()) return "";
+  std::string text = ss.str();
+  for (const auto& [pattern, replacement] : replacements) {
+    if (!std::regex_search(text, std::regex(pattern))) return "";
+    text = std::regex_replace(text, std::regex(pattern), replacement);
+  }
   const std::string path = testing::TempDir() + "/" + file;
-  std::ofstream(path) << changed;
+  std::ofstream(path) << text;
   return path;
+}
+
+std::string shipped_config_with(const std::string& service, const std::string& pattern, const std::string& replacement,
+                                const std::string& file) {
+  return shipped_config_with(service, {{pattern, replacement}}, file);
 }
 
 DiffReport replay_chain(const std::vector<std::string>& services) {
@@ -172,10 +187,15 @@ namespace {
 // were handed over to the librarian.
 const std::string kPlannerSample = std::string(BOOKGRASP_SOURCE_DIR) + "/logs/samples/planner_lower_shelf.lcm";
 
+// planner.yaml with the search's step limit at `steps` and the wall clock out of the search
+// (`wall_clock_stop: false`): the recorded requests carry a time budget in seconds of the recording machine's clock,
+// which a starved test process can exhaust before the step limit; the step count alone gives the recorded answers.
 std::string planner_config_with_steps(const std::string& steps) {
-  const std::string path = shipped_config_with("planner", "max_search_steps: [0-9]+", "max_search_steps: " + steps,
-                                               "planner_steps_" + steps + ".yaml");
-  EXPECT_FALSE(path.empty()) << "planner.yaml has no max_search_steps, or it is " << steps << " already";
+  const std::string path = shipped_config_with(
+      "planner",
+      {{"max_search_steps: [0-9]+", "max_search_steps: " + steps}, {"wall_clock_stop: true", "wall_clock_stop: false"}},
+      "planner_steps_" + steps + ".yaml");
+  EXPECT_FALSE(path.empty()) << "planner.yaml has no max_search_steps or no wall_clock_stop: true";
   return path;
 }
 
@@ -210,13 +230,18 @@ TEST(PlannerReplay, TheRecordedBudgetReproducesEveryPlanAndFailureBitForBit) {
   EXPECT_EQ(failed, 7) << "the sample holds the deployed run's seven 'no path' answers";
 }
 
-// With the shipped budget the first request of every move in the sample gets a collision-free path, among them the
-// three the deployed run failed (a retry carries its first request's utime, so a first request has request_id ==
-// utime). Plans the recording found are found again unchanged: the budget only matters where a search ran out.
+// With the shipped step budget (the wall clock out of the search, as in the test above) the first request of every move
+// in the sample gets a collision-free path, among them the three the deployed run failed (a retry carries its first
+// request's utime, so a first request has request_id == utime). Plans the recording found are found again unchanged:
+// the budget only matters where a search ran out.
 TEST(PlannerReplay, TheShippedBudgetPlansEveryFirstRequestTheRecordingMissed) {
   const auto log = read_lcm_log(kPlannerSample);
   const std::vector<plan_result_t> recorded = plan_results(log);
-  const std::vector<plan_result_t> replayed = plan_results(replay_planner(log, "").outputs);
+  const std::vector<plan_result_t> replayed = plan_results(
+      replay_planner(log, planner_config_with_steps(std::to_string(
+                              PlannerSettings::load(std::string(BOOKGRASP_SOURCE_DIR) + "/config/services/planner.yaml")
+                                  .planner.max_search_steps)))
+          .outputs);
   ASSERT_EQ(replayed.size(), recorded.size());
   int missed_first_tries = 0;
   for (size_t i = 0; i < recorded.size(); ++i) {
