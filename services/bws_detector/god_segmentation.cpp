@@ -431,6 +431,7 @@ GodParams GodParams::from_config(const Config& c) {
   p.flat_mgod_max = c.get_double("flat_mgod_max", 0.0, 1e6);
   p.window_size = c.get_int("window_size", 1, 101);
   p.jump_mgod_min = c.get_double("jump_mgod_min", 0.0, 1e9);
+  p.jump_min_curvature = c.get_double("jump_min_curvature", 0.0, 1e9);
   p.merge_distance = c.get_double("merge_distance", 0.0, 1e9);
   p.merge_space =
       c.get_choice("merge_space", {"image", "points"}) == "image" ? MergeSpace::kImage : MergeSpace::kPoints;
@@ -456,6 +457,7 @@ void GodParams::validate() const {
   if (window_size < 1 || window_size % 2 == 0) throw std::invalid_argument("window_size must be odd and >= 1");
   if (!(flat_mgod_max >= 0.0)) throw std::invalid_argument("flat_mgod_max must be >= 0");
   if (!(jump_mgod_min > flat_mgod_max)) throw std::invalid_argument("jump_mgod_min must be > flat_mgod_max");
+  if (!(jump_min_curvature >= 0.0)) throw std::invalid_argument("jump_min_curvature must be >= 0");
   if (!(merge_distance >= 0.0)) throw std::invalid_argument("merge_distance must be >= 0");
   if (adjacency_radius_px < 1) throw std::invalid_argument("adjacency_radius_px must be >= 1");
   if (boundary_growth_px < 0) throw std::invalid_argument("boundary_growth_px must be >= 0");
@@ -608,6 +610,30 @@ cv::Mat god_bins(const GodFeatures& f, int B, double jump_mgod_min) {
     }
   }
   return bins;
+}
+
+void keep_steep_planes(const cv::Mat& image, int s, int B, double jump_mgod_min, double max_curvature, cv::Mat& bins) {
+  if (image.type() != CV_32F || bins.type() != CV_8U || bins.size() != image.size())
+    throw std::invalid_argument("keep_steep_planes: CV_32F image and CV_8U bins of the same size expected");
+  if (s < 1 || B < 2 || B > 254) throw std::invalid_argument("keep_steep_planes: bad gradient step or bin count");
+  const float w = 360.f / float(B), jump = float(jump_mgod_min), c = float(max_curvature);
+  for (int y = s; y < image.rows - s; ++y) {
+    const float* up = image.ptr<float>(y - s);
+    const float* mid = image.ptr<float>(y);
+    const float* dn = image.ptr<float>(y + s);
+    uint8_t* b = bins.ptr<uint8_t>(y);
+    for (int x = s; x < image.cols - s; ++x) {
+      if (b[x] != 255) continue;
+      const float m0 = mid[x], r = mid[x + s], l = mid[x - s], d = dn[x], u = up[x];
+      if (!(valid_value(m0) && valid_value(r) && valid_value(l) && valid_value(d) && valid_value(u))) continue;
+      const float dx = r - l, dy = d - u;
+      if (!(std::sqrt(dx * dx + dy * dy) > jump)) continue;
+      if (std::abs(r - 2.f * m0 + l) > c || std::abs(d - 2.f * m0 + u) > c) continue;
+      int k = int(direction_deg(dx, dy) / w + 0.5f);
+      if (k >= B) k -= B;
+      b[x] = uint8_t(k);
+    }
+  }
 }
 
 namespace {
@@ -1144,6 +1170,9 @@ SegmentationResult segment_god(const cv::Mat& image, const cv::Mat& points, cons
     god_bins_of_image(gradient_input, params.gradient_step, params.flat_mgod_max, params.direction_bins,
                       params.jump_mgod_min, bins);
   }
+  if (params.jump_min_curvature > 0)
+    keep_steep_planes(gradient_input, params.gradient_step, params.direction_bins, params.jump_mgod_min,
+                      params.jump_min_curvature, bins);
   if (params.window_size <= 15)
     vote_clusters_into(bins, params.direction_bins + 1, params.window_size, clusters, ws.col8);
   else

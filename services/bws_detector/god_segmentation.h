@@ -52,6 +52,10 @@ struct GodParams {
   int window_size = 7;
   /// Pixels with MGoD > this are jump edges: they neither vote nor get a cluster (image units).
   double jump_mgod_min = 1.0;
+  /// > 0: a pixel with MGoD > jump_mgod_min is a jump edge only where the gradient also changes across it,
+  /// max(|P(y,x+s) - 2P(y,x) + P(y,x-s)|, |P(y+s,x) - 2P(y,x) + P(y-s,x)|) > this (image units); elsewhere it is a
+  /// steep plane (a surface seen at a grazing angle) and votes with its direction. 0 = MGoD alone (the paper).
+  double jump_min_curvature = 0.0;
   /// T_dis: two adjacent regions merge when the RMS distance of the smaller region's points to the
   /// larger region's plane is below this (unit of merge_space).
   double merge_distance = 0.75;
@@ -109,6 +113,12 @@ cv::Mat god_bins(const GodFeatures& features, int direction_bins, double jump_mg
 /// n x n neighbourhood (ties: lowest bin); non-voting pixels stay 255. Sliding
 /// column histograms: O(N * bins), independent of n. CV_8U in, CV_8U out.
 cv::Mat vote_clusters(const cv::Mat& bins, int num_bins, int window_size);
+
+/// Gives the pixels that god_bins left out as jump edges (MGoD > jump_mgod_min) their direction bin back where
+/// the second differences along x and y are both <= max_curvature (GodParams::jump_min_curvature): a steep
+/// plane, not a step between surfaces. `image` is the gradients' input; pixels with no feature stay 255.
+void keep_steep_planes(const cv::Mat& image, int gradient_step, int direction_bins, double jump_mgod_min,
+                       double max_curvature, cv::Mat& bins);
 
 /// 4-connected components of equal values of a CV_8U image (255 = background).
 /// Returns CV_32S labels 1..count (0 background) in raster order; count in *count.

@@ -11,6 +11,7 @@
 /// ball added on the upper shelf (unless --no-curved). Writes DIR/metrics.json, DIR/report.md and
 /// DIR/scene_<seed>.png for the first K scenes (default 3). Progress on stderr.
 
+#include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -29,11 +30,13 @@ int usage(const std::string& why) {
   std::cerr << "usage: bookgrasp_eval_segmentation --out DIR [--scenes N] [--seed S] [--scene FILE] [--no-curved]\n"
                "                                   [--no-stereo] [--noise PX] [--pictures K] [--god-config FILE]\n"
                "                                   [--pcl-config FILE] [--min-gt-px P] [--stereo-algorithm bm|sgbm]\n"
-               "                                   [--verbose]\n"
+               "                                   [--steep-curvature PX] [--verbose]\n"
                "  renders scenes S..S+N-1 (default 20 scenes from seed 1) with ground-truth surfaces, runs GoD,\n"
                "  PCL and jump components on the true-depth and the StereoBM disparity, compares them by Hoover's\n"
                "  metric at T = 0.5..0.9 (GT regions >= P px, default 100; StereoBM as configured, or SGBM); writes "
-               "DIR/metrics.json, DIR/report.md, DIR/scene_<seed>.png\n";
+               "DIR/metrics.json, DIR/report.md, DIR/scene_<seed>.png\n"
+               "  --steep-curvature PX: the method god_steep is GoD with god.jump_min_curvature PX (default 0.6;\n"
+               "  0 = no god_steep)\n";
   return why.empty() ? 0 : 2;
 }
 
@@ -49,7 +52,7 @@ int main(int argc, char** argv) {
   long long scenes = 20, seed = 1, pictures = 3, min_gt_px = 100;
   std::string stereo_algorithm = "bm";
   bool curved = true, stereo = true, verbose = false;
-  double noise = 0.1;
+  double noise = 0.1, steep_curvature = 0.6;
   std::string scene_file = "config/scenes/default.yaml", out_dir;
   std::string god_config = "config/services/bws_detector.yaml", pcl_config = "config/services/bws_detector_pcl.yaml";
   std::string command = "bookgrasp_eval_segmentation";
@@ -92,6 +95,11 @@ int main(int argc, char** argv) {
       char* end = nullptr;
       noise = std::strtod(v.c_str(), &end);
       if (v.empty() || !end || *end != '\0' || !(noise >= 0)) return usage("--noise must be a number >= 0 (pixels)");
+    } else if (a == "--steep-curvature") {
+      char* end = nullptr;
+      steep_curvature = std::strtod(v.c_str(), &end);
+      if (v.empty() || !end || *end != '\0' || !(steep_curvature >= 0) || !std::isfinite(steep_curvature))
+        return usage("--steep-curvature must be a number >= 0 (disparity pixels), not '" + v + "'");
     } else if (a == "--scene") {
       scene_file = v;
     } else if (a == "--god-config") {
@@ -109,6 +117,7 @@ int main(int argc, char** argv) {
     scene_file = in_source(scene_file);
     EvalConfig config = EvalConfig::from_files(in_source(god_config), in_source(pcl_config));
     config.true_noise_px = noise;
+    config.steep_curvature = steep_curvature;
     config.stereo = stereo;
     if (stereo_algorithm == "sgbm") config.god.disparity.algorithm = bookgrasp::bws::StereoAlgorithm::kSemiGlobal;
     std::filesystem::create_directories(out_dir);

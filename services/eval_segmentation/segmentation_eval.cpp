@@ -99,6 +99,11 @@ void run_methods(const std::string& suffix, const cv::Mat& disparity, const bws:
     runs->push_back(std::move(r));
   };
   run("god", [&] { return bws::segment(disparity, points, c.god); });
+  if (c.steep_curvature > 0) {
+    bws::BwsParams steep = c.god;
+    steep.god.jump_min_curvature = c.steep_curvature;
+    run("god_steep", [&] { return bws::segment(disparity, points, steep); });
+  }
   run("pcl", [&] { return bws::segment(disparity, points, c.pcl); });
   run("jump", [&] { return bws::segment_jump_components(disparity, points, c.jump); });
   run("rg", [&] {
@@ -328,7 +333,12 @@ std::string report_markdown(const std::vector<SceneEval>& scenes, const EvalConf
     m << "\n";
   }
   m << "\nNotes: T = 0.5 is evaluated at 0.500001 (Hoover's T must exceed 0.5). Timings are wall clock on a shared "
-       "machine.\n";
+       "machine.";
+  if (c.steep_curvature > 0)
+    m << " god = GoD as bws_detector is configured (god.jump_min_curvature " << c.god.god.jump_min_curvature
+      << "); god_steep = the same with god.jump_min_curvature " << c.steep_curvature
+      << " (a pixel is a jump edge only where the disparity also bends: steep planes keep their direction).";
+  m << "\n";
   return m.str();
 }
 

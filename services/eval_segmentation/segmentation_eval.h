@@ -38,6 +38,9 @@ struct EvalConfig {
   bws::JumpComponentsParams jump;
   /// Region growing on normals (pcl::RegionGrowing, like Hoover's USF), its defaults (the PCL tutorial's values).
   RegionGrowingParams region_growing;
+  /// > 0: also the method `god_steep`, the GoD above with god.jump_min_curvature at this value (jump edges must
+  /// bend the disparity; steep planes, e.g. surfaces at a grazing angle, keep their direction). 0: no such method.
+  double steep_curvature = 0.6;
   /// Noise of the "true" source, disparity pixels (standard deviation).
   double true_noise_px = 0.1;
   /// Rounding step of the "true" source, disparity pixels (StereoBM: 1/16).

@@ -83,7 +83,7 @@ TEST(BwsConfig, BadValuesNameTheKey) {
   const auto err = [](const std::string& yaml) { return config_error<GodParams>(yaml, "god"); };
   const std::string ok =
       "god: {gradient_step: 1, smoothing_radius_px: 2, smoothing_max_difference: 1.0, direction_bins: 16, "
-      "flat_mgod_max: 0.0, window_size: 5, jump_mgod_min: 0.6, "
+      "flat_mgod_max: 0.0, window_size: 5, jump_mgod_min: 0.6, jump_min_curvature: 0.0, "
       "merge_distance: 0.75, merge_space: image, merge_max_angle_deg: 30, merge_angle_min_px: 100, "
       "adjacency_radius_px: 2, boundary_growth_px: 2, boundary_growth_distance: 0.25, min_region_px: 30}";
   EXPECT_EQ(err(ok), "");

@@ -220,6 +220,63 @@ TEST(SegmentGod, MergingJoinsFragmentsOfOnePlaneButNotParallelPlanes) {
   for (const PlaneRegion& reg : r.regions) EXPECT_GT(reg.pixel_count, (reg.centroid.x() < 60 ? 60 : 40) * 80 * 0.9);
 }
 
+// A steep plane (MGoD 2 > jump_mgod_min) beside a step: god_bins leaves both out; keep_steep_planes gives the
+// plane's pixels their direction back (second differences 0) and leaves the step's two columns out (second
+// differences of the step's size).
+TEST(GodBins, ASteepPlaneIsKeptAndAStepStaysAJumpEdge) {
+  cv::Mat img(40, 60, CV_32F);
+  for (int y = 0; y < 40; ++y)
+    for (int x = 0; x < 60; ++x) img.at<float>(y, x) = float(x < 30 ? 10.0 + 1.0 * x : 100.0);
+  const int B = 16;
+  cv::Mat bins = god_bins(compute_god_features(img, 1, 0.0), B, 0.5);
+  EXPECT_EQ(bins.at<uint8_t>(20, 15), 255) << "MGoD alone takes the steep plane for a jump edge";
+  keep_steep_planes(img, 1, B, 0.5, 0.5, bins);
+  for (int x = 1; x < 29; ++x) EXPECT_EQ(bins.at<uint8_t>(20, x), 0) << "x " << x << ": direction 360 deg, bin 0";
+  EXPECT_EQ(bins.at<uint8_t>(20, 29), 255);
+  EXPECT_EQ(bins.at<uint8_t>(20, 30), 255);
+  EXPECT_EQ(bins.at<uint8_t>(20, 45), B) << "the flat part keeps its flat bin";
+  EXPECT_EQ(bins.at<uint8_t>(0, 15), 255) << "border pixels have no feature";
+  cv::Mat small(10, 10, CV_8U, cv::Scalar(255));
+  EXPECT_THROW(keep_steep_planes(img, 1, B, 0.5, 0.5, small), std::invalid_argument);
+}
+
+// A surface seen at a grazing angle (disparity rising 1 px per column) beside a frontal one, meeting at a crease:
+// with MGoD alone the grazing surface is all jump edge and gets no region; with jump_min_curvature it is one region
+// of its own (the crease's second difference keeps the two apart), and a step between parallel planes still
+// separates them.
+TEST(SegmentGod, TheCurvatureTestKeepsASurfaceAtAGrazingAngle) {
+  cv::Mat img(60, 90, CV_32F);
+  for (int y = 0; y < 60; ++y)
+    for (int x = 0; x < 90; ++x)
+      img.at<float>(y, x) = float(x < 50 ? 30.0 + 0.01 * x + 0.02 * y : 30.5 + 1.0 * (x - 50) + 0.02 * y);
+  GodParams p = test_params();
+  p.jump_mgod_min = 0.6;
+  const auto grazing_labels = [&](const SegmentationResult& r) {
+    std::map<int, int> n;
+    for (int y = 5; y < 55; ++y)
+      for (int x = 53; x < 87; ++x) ++n[r.labels.at<int>(y, x)];
+    return n;
+  };
+  const SegmentationResult off = segment_god(img, cv::Mat(), p);
+  EXPECT_EQ(grazing_labels(off)[0], 50 * 34) << "MGoD alone: the grazing surface is unlabelled";
+  p.jump_min_curvature = 0.6;
+  const SegmentationResult on = segment_god(img, cv::Mat(), p);
+  const std::map<int, int> n = grazing_labels(on);
+  ASSERT_EQ(n.size(), 1u);
+  const int grazing = n.begin()->first;
+  ASSERT_GT(grazing, 0);
+  EXPECT_NE(on.labels.at<int>(30, 20), grazing);
+  EXPECT_GT(on.labels.at<int>(30, 20), 0);
+  const PlaneRegion& reg = on.regions[size_t(grazing - 1)];
+  EXPECT_NEAR(-reg.normal.x() / reg.normal.z(), 1.0, 1e-4);
+  cv::Mat steps(50, 80, CV_32F);
+  for (int y = 0; y < 50; ++y)
+    for (int x = 0; x < 80; ++x) steps.at<float>(y, x) = float(30.0 + 0.1 * y + (x < 40 ? 0.0 : 2.0));
+  const SegmentationResult parallel = segment_god(steps, cv::Mat(), p);
+  ASSERT_EQ(parallel.regions.size(), 2u);
+  EXPECT_NE(parallel.labels.at<int>(25, 39), parallel.labels.at<int>(25, 40));
+}
+
 TEST(SegmentGod, MergeSpacePointsUsesTheCallersUnits) {
   // Same crease, merge measured in "points" given as (x, y, 10 * value): distances scale by ~10.
   cv::Mat img = affine_image(40, 30, 0.1, 0.0, 10.0);
