@@ -10,7 +10,8 @@
 # the BwS selection changes of stop 17; re-recorded 2026-12-05 for BwS's top_growth_climbed_only, stop 30, and for
 # GoD's smoothed gradients, stop 34, and for the front layer and the hole budget of stop 35; re-recorded 2026-12-07
 # with 35 s for BSwH's colour check, stop 45: with 20 and 25 s the log ended early in the stripe servo, 79 and 48
-# SERVO_STATUS, fewer than the visual servo's replay test needs).
+# SERVO_STATUS, fewer than the visual servo's replay test needs); re-recorded 2026-12-07 (35 s, 38 MB) for BwS's
+# front_plane (stop 46: 45 of the old sample's 74 P1s moved).
 set -euo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 OUT="$1"; SECONDS_TO_RECORD="${2:-3}"

@@ -42,6 +42,8 @@ SelectionParams SelectionParams::from_config(const Config& c) {
   p.edge_fattening_px = c.get_double("edge_fattening_px", 0.0, 100.0);
   p.pi_rule =
       c.get_choice("pi_rule", {"paper", "right_column_top"}) == "paper" ? PiRule::kPaper : PiRule::kRightColumnTop;
+  p.front_plane =
+      c.get_choice("front_plane", {"region", "rear_board"}) == "region" ? FrontPlane::kRegion : FrontPlane::kRearBoard;
   return p;
 }
 
@@ -682,8 +684,10 @@ BookFrontResult select_book_front(const SegmentationResult& seg, const cv::Mat& 
   }
   cv::Mat grow_mask = out.split ? band_mask : inside_mask;
   Eigen::Vector3d normal = r.normal;  // of the plane PI's front lies in (left camera frame)
-  if (p.layer_disparity_px > 0.0) {
-    // The layer through the selected front's pixels.
+  // The selected front's points' median offset along the rear board's normal: the plane parallel to the rear
+  // board through the front (FrontPlane::kRearBoard) and the layer's start. NaN when none has a point.
+  double rear_offset = std::numeric_limits<double>::quiet_NaN();
+  if (p.front_plane == FrontPlane::kRearBoard || p.layer_disparity_px > 0.0) {
     std::vector<double> offs;
     for (int y = r.bbox.y; y < r.bbox.y + r.bbox.height; ++y) {
       const int* m = grow_mask.ptr<int>(y);
@@ -692,17 +696,23 @@ BookFrontResult select_book_front(const SegmentationResult& seg, const cv::Mat& 
         if (m[x] == best && finite_point(q[x]))
           offs.push_back(rear_cam.dot(Eigen::Vector3d(q[x][0], q[x][1], q[x][2])));
     }
-    if (!offs.empty()) {
-      const FrontLayer layer =
-          rightmost_front_on_layer(points_camera, g, rear_cam, quantile(offs, 0.5), cam_in_box, shelf.half_extent,
-                                   std::max(0, out.pi.x - p.top_growth.columns), best, p);
-      if (layer.top.x > out.pi.x + p.layer_min_shift_px) {
-        out.pi = layer.top;
-        out.pi_from_layer = true;
-        grow_mask = layer.mask;
-        normal = rear_cam;
-        offset = layer.offset;
-      }
+    if (!offs.empty()) rear_offset = quantile(offs, 0.5);
+  }
+  if (p.front_plane == FrontPlane::kRearBoard && std::isfinite(rear_offset)) {
+    normal = rear_cam;
+    offset = rear_offset;
+  }
+  if (p.layer_disparity_px > 0.0 && std::isfinite(rear_offset)) {
+    // The layer through the selected front's pixels.
+    const FrontLayer layer =
+        rightmost_front_on_layer(points_camera, g, rear_cam, rear_offset, cam_in_box, shelf.half_extent,
+                                 std::max(0, out.pi.x - p.top_growth.columns), best, p);
+    if (layer.top.x > out.pi.x + p.layer_min_shift_px) {
+      out.pi = layer.top;
+      out.pi_from_layer = true;
+      grow_mask = layer.mask;
+      normal = rear_cam;
+      offset = layer.offset;
     }
   }
   return p1_on_plane(grow_mask, best, normal, offset, points_camera, g, camera_in_base, p, std::move(out));

@@ -10,9 +10,11 @@
 /// y = smallest row of the region), i.e. the top-right corner of the region's
 /// bounding box. If that pixel is not in the region, PI is the region pixel
 /// nearest to it (Euclidean in pixels; ties: smaller row, then larger column).
-/// P1 is where the viewing ray through the centre of PI meets the region's
-/// fitted plane (so a noisy disparity at PI itself does not matter); if the
-/// ray is nearly parallel to the plane, the region's 3D point at PI is used.
+/// P1 is where the viewing ray through the centre of PI meets the front's
+/// plane (so a noisy disparity at PI itself does not matter): the region's
+/// fitted plane (the paper's) or the plane parallel to the rear board through
+/// the front's points (SelectionParams::front_plane); if the ray is nearly
+/// parallel to the plane, the region's 3D point at PI is used.
 
 #include <string>
 #include <vector>
@@ -46,6 +48,18 @@ enum class PiRule {
   /// The top of the region's right-most well-filled column (right_column_top): the right-most book's
   /// own top even when a taller front to its left is part of the same region or band.
   kRightColumnTop,
+};
+
+/// The plane P1 lies on, for a front selected from a region (config `selection.front_plane`); the front layer
+/// always uses the rear board's.
+enum class FrontPlane {
+  /// The region's own fitted plane: the paper's.
+  kRegion,
+  /// The plane parallel to the cart's rear board (its normal from the cart marker) through the median of the
+  /// selected front's points: a front that passed the parallel test is taken as parallel, so pixels of a top
+  /// face or a neighbour's cover in the region do not tilt it (the region's plane put P1 1.5 mm too deep on
+  /// average, docs/BWS.md "The front's plane").
+  kRearBoard,
 };
 
 /// How raise_to_plane_top moves PI up its column to the top of the front's plane (config keys
@@ -128,6 +142,8 @@ struct SelectionParams {
   /// surface into a farther background by up to half a block ((block_size - 1) / 2), and the
   /// right-most front's right and top edges border a farther background. 0 = the ray through PI.
   double edge_fattening_px = 0.0;
+  /// The plane the top's growth climbs and P1's ray meets, for a front selected from a region.
+  FrontPlane front_plane = FrontPlane::kRegion;
 
   /// Reads every key of the `selection` section.
   static SelectionParams from_config(const Config& section);

@@ -254,6 +254,47 @@ TEST(SelectBookFront, ExactDisparityP1WithinAFewMillimetres) {
   }
 }
 
+// The front's plane: the selected region's fitted plane tilted by 8 deg about the camera's x axis through its centroid
+// (what pixels of a receding top face or of a cover do to a TLS fit; within the 15 deg parallel test). With
+// front_plane = region, P1 (the top corner, far from the centroid) moves along its ray by over a centimetre; with
+// rear_board the plane is the rear board's (from the cart volume) through the front's median point, and P1 stays
+// within the exact-disparity test's 6 mm of the true corner.
+TEST(SelectBookFront, TheRearBoardsPlaneKeepsATiltedFitFromMovingP1) {
+  const test::ShelfScene scene = test::make_shelf_scene(1);
+  const test::RenderOutput ren = test::render_boxes(scene.boxes, scene.left, false);
+  const cv::Mat disp = test::exact_disparity(ren.depth, scene.left.fx, scene.baseline_m);
+  const StereoGeometry g{scene.left.fx, scene.left.fy, scene.left.cx, scene.left.cy, scene.baseline_m};
+  const cv::Mat pts = disparity_to_points(disp, g);
+  const SegmentationResult seg = segment_god(disp, pts, god_params());
+  const ShelfVolume shelf{scene.shelf_box_in_base, scene.shelf_half_extent};
+  SelectionParams region = selection_params();
+  region.front_plane = FrontPlane::kRegion;
+  SelectionParams rear = region;
+  rear.front_plane = FrontPlane::kRearBoard;
+  const BookFrontResult fit = select_book_front(seg, pts, g, scene.left.in_base, shelf, region);
+  ASSERT_TRUE(fit.found) << fit.failure_reason;
+  const BookFrontResult untilted = select_book_front(seg, pts, g, scene.left.in_base, shelf, rear);
+  ASSERT_TRUE(untilted.found) << untilted.failure_reason;
+  EXPECT_LT((untilted.p1_base - scene.true_corner_base).norm(), 0.006);
+
+  SegmentationResult tilted = seg;
+  PlaneRegion& r = tilted.regions.at(size_t(fit.selected_label - 1));
+  r.normal = (Eigen::AngleAxisd(8.0 * M_PI / 180.0, Eigen::Vector3d::UnitX()) * r.normal).normalized();
+  r.offset = r.normal.dot(r.centroid);
+  const BookFrontResult moved = select_book_front(tilted, pts, g, scene.left.in_base, shelf, region);
+  const BookFrontResult kept = select_book_front(tilted, pts, g, scene.left.in_base, shelf, rear);
+  ASSERT_TRUE(moved.found) << moved.failure_reason;
+  ASSERT_TRUE(kept.found) << kept.failure_reason;
+  ASSERT_EQ(moved.selected_label, fit.selected_label);
+  ASSERT_EQ(kept.selected_label, fit.selected_label);
+  const double moved_mm = 1e3 * (moved.p1_base - scene.true_corner_base).norm();
+  const double kept_mm = 1e3 * (kept.p1_base - scene.true_corner_base).norm();
+  std::printf("P1 from a plane tilted 8 deg: region %.1f mm, rear_board %.1f mm from the true corner\n", moved_mm,
+              kept_mm);
+  EXPECT_GT(moved_mm, 10.0);
+  EXPECT_LT(kept_mm, 6.0);
+}
+
 // End to end from textured stereo renders through StereoBM. At ~1.4 m a 1-3.5 cm book front is 4-14 px
 // wide: StereoBM smears it with the grazing side face, and the plane of so narrow a region is poorly
 // determined about the vertical axis, so the right-most front is often dropped as "not parallel"

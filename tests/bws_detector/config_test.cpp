@@ -137,6 +137,9 @@ TEST(BwsConfig, BadSelectionValuesNameTheKey) {
             std::string::npos);
   EXPECT_NE(err(replaced(ok, "  layer_without_front_m:", "  # gone:")).find("layer_without_front_m"),
             std::string::npos);
+  EXPECT_NE(err(replaced(ok, "front_plane: rear_board", "front_plane: cart")).find("front_plane"), std::string::npos);
+  EXPECT_NE(err(replaced(ok, "  front_plane:", "  # gone:")).find("front_plane"), std::string::npos);
+  EXPECT_EQ(err(replaced(ok, "front_plane: rear_board", "front_plane: region")), "");
 }
 
 TEST(BwsConfig, BadPclSpaceValuesNameTheKey) {
