@@ -57,7 +57,7 @@ enum class FrontPlane {
   kRegion,
   /// The plane parallel to the cart's rear board (its normal from the cart marker) through the median of the
   /// selected front's points: a front that passed the parallel test is taken as parallel, so pixels of a top
-  /// face or a neighbour's cover in the region do not tilt it (the region's plane put P1 1.5 mm too deep on
+  /// face or a neighbour's cover in the region do not tilt it (the region's plane put P1 1.6 mm too deep on
   /// average, docs/BWS.md "The front's plane").
   kRearBoard,
 };
