@@ -102,6 +102,12 @@ TEST(BwsConfig, BadValuesNameTheKey) {
   bad = ok;
   bad.replace(bad.find(" smoothing_max_difference: 1.0,"), 31, "");
   EXPECT_NE(err(bad).find("smoothing_max_difference"), std::string::npos);
+  bad = ok;
+  bad.replace(bad.find("jump_min_curvature: 0.0"), 23, "jump_min_curvature: -0.6");
+  EXPECT_NE(err(bad).find("jump_min_curvature"), std::string::npos);
+  bad = ok;
+  bad.replace(bad.find(" jump_min_curvature: 0.0,"), 25, "");
+  EXPECT_NE(err(bad).find("jump_min_curvature"), std::string::npos);
 }
 
 TEST(BwsConfig, BadSelectionValuesNameTheKey) {

@@ -435,6 +435,13 @@ TEST(PlannerSettingsTest, NoWallClockStopNeedsAStepLimit) {
   }
   const std::string missing = with("  wall_clock_stop: true[^\n]*\n", "", shipped);
   EXPECT_THROW(PlannerSettings::from_config(Config::from_string(missing, "missing.yaml")), ConfigError);
+  const std::string bad = with("wall_clock_stop: true", "wall_clock_stop: sometimes", shipped);
+  try {
+    PlannerSettings::from_config(Config::from_string(bad, "bad.yaml"));
+    ADD_FAILURE() << "a wall_clock_stop that is not a bool must be refused";
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("wall_clock_stop"), std::string::npos) << e.what();
+  }
 }
 
 TEST_F(MotionPlannerTest, AStartWithinTheMarginIsLeftStraightFirst) {
