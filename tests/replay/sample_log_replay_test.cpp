@@ -12,7 +12,6 @@
 
 #include "bookgrasp/arm_command_t.hpp"
 #include "bookgrasp/plan_result_t.hpp"
-#include "services/planner/planner_config.h"
 #include "services/replay/component_registry.h"
 #include "services/replay/output_diff.h"
 #include "services/replay/replay_runner.h"
@@ -24,8 +23,6 @@ const std::string kSample = std::string(BOOKGRASP_SOURCE_DIR) + "/logs/samples/s
 // Wall-clock timing fields are the only ones that are not reproducible.
 const std::set<std::string> kTiming = {"processing_ms", "disparity_ms", "segmentation_ms", "total_ms"};
 
-// config/services/<service>.yaml with `pattern` replaced by `replacement`, written to TempDir()/<file>; "" when the
-// replacement changed nothing (the shipped file no longer has the pattern).
 // config/services/<service>.yaml with every (pattern, replacement) applied in order, written to the test's temporary
 // directory as `file`; "" when some pattern is not in the text it is applied to.
 std::string shipped_config_with(const std::string& service,
@@ -44,6 +41,7 @@ std::string shipped_config_with(const std::string& service,
   return path;
 }
 
+// The same with one (pattern, replacement).
 std::string shipped_config_with(const std::string& service, const std::string& pattern, const std::string& replacement,
                                 const std::string& file) {
   return shipped_config_with(service, {{pattern, replacement}}, file);
@@ -187,15 +185,15 @@ namespace {
 // were handed over to the librarian.
 const std::string kPlannerSample = std::string(BOOKGRASP_SOURCE_DIR) + "/logs/samples/planner_lower_shelf.lcm";
 
-// planner.yaml with the search's step limit at `steps` and the wall clock out of the search
-// (`wall_clock_stop: false`): the recorded requests carry a time budget in seconds of the recording machine's clock,
-// which a starved test process can exhaust before the step limit; the step count alone gives the recorded answers.
-std::string planner_config_with_steps(const std::string& steps) {
-  const std::string path = shipped_config_with(
-      "planner",
-      {{"max_search_steps: [0-9]+", "max_search_steps: " + steps}, {"wall_clock_stop: true", "wall_clock_stop: false"}},
-      "planner_steps_" + steps + ".yaml");
-  EXPECT_FALSE(path.empty()) << "planner.yaml has no max_search_steps or no wall_clock_stop: true";
+// planner.yaml with the wall clock out of the search (`wall_clock_stop: false`) and, unless `steps` is empty, the
+// search's step limit at `steps`: the recorded requests carry a time budget in seconds of the recording machine's
+// clock, which a starved test process can exhaust before the step limit; the step count alone gives the recorded
+// answers.
+std::string planner_config_without_the_clock(const std::string& steps = "") {
+  std::vector<std::pair<std::string, std::string>> replacements = {{"wall_clock_stop: true", "wall_clock_stop: false"}};
+  if (!steps.empty()) replacements.emplace_back("max_search_steps: [0-9]+", "max_search_steps: " + steps);
+  const std::string path = shipped_config_with("planner", replacements, "planner_steps_" + steps + ".yaml");
+  EXPECT_FALSE(path.empty()) << "planner.yaml has no wall_clock_stop: true or no max_search_steps";
   return path;
 }
 
@@ -220,7 +218,7 @@ ReplayRun replay_planner(const std::vector<LoggedMessage>& log, const std::strin
 // with the configuration it ran with, every recorded plan and every recorded failure comes back byte for byte.
 TEST(PlannerReplay, TheRecordedBudgetReproducesEveryPlanAndFailureBitForBit) {
   const auto log = read_lcm_log(kPlannerSample);
-  const ReplayRun run = replay_planner(log, planner_config_with_steps("30000"));
+  const ReplayRun run = replay_planner(log, planner_config_without_the_clock("30000"));
   const DiffReport r = diff_outputs(log, run.outputs, {"PLAN_RESULT"}, {"planning_time_s"}, run.fed_utimes);
   ASSERT_EQ(r.channels.size(), 1u) << r.markdown();
   EXPECT_EQ(r.channels[0].matched, 26) << r.markdown();
@@ -237,11 +235,8 @@ TEST(PlannerReplay, TheRecordedBudgetReproducesEveryPlanAndFailureBitForBit) {
 TEST(PlannerReplay, TheShippedBudgetPlansEveryFirstRequestTheRecordingMissed) {
   const auto log = read_lcm_log(kPlannerSample);
   const std::vector<plan_result_t> recorded = plan_results(log);
-  const std::vector<plan_result_t> replayed = plan_results(
-      replay_planner(log, planner_config_with_steps(std::to_string(
-                              PlannerSettings::load(std::string(BOOKGRASP_SOURCE_DIR) + "/config/services/planner.yaml")
-                                  .planner.max_search_steps)))
-          .outputs);
+  const std::vector<plan_result_t> replayed =
+      plan_results(replay_planner(log, planner_config_without_the_clock()).outputs);
   ASSERT_EQ(replayed.size(), recorded.size());
   int missed_first_tries = 0;
   for (size_t i = 0; i < recorded.size(); ++i) {
