@@ -11,7 +11,8 @@
 # GoD's smoothed gradients, stop 34, and for the front layer and the hole budget of stop 35; re-recorded 2026-12-07
 # with 35 s for BSwH's colour check, stop 45: with 20 and 25 s the log ended early in the stripe servo, 79 and 48
 # SERVO_STATUS, fewer than the visual servo's replay test needs); re-recorded 2026-12-07 (35 s, 38 MB) for BwS's
-# front_plane (stop 46: 45 of the old sample's 74 P1s moved).
+# front_plane (stop 46: 45 of the old sample's 74 P1s moved); re-recorded 2026-12-08 (35 s) for BwS's top_crease
+# (stop 47).
 set -euo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 OUT="$1"; SECONDS_TO_RECORD="${2:-3}"

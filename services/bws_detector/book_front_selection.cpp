@@ -44,6 +44,7 @@ SelectionParams SelectionParams::from_config(const Config& c) {
       c.get_choice("pi_rule", {"paper", "right_column_top"}) == "paper" ? PiRule::kPaper : PiRule::kRightColumnTop;
   p.front_plane =
       c.get_choice("front_plane", {"region", "rear_board"}) == "region" ? FrontPlane::kRegion : FrontPlane::kRearBoard;
+  p.top_crease = TopCreaseParams::from_config(c);
   return p;
 }
 
@@ -381,9 +382,11 @@ double densest_layer_offset(const cv::Mat& points_camera, const Eigen::Isometry3
 }
 
 /// The end of the selection: PI (out.pi, on the pixels of `label` in `mask`) grows up the front's
-/// plane { normal . p = offset } (left camera frame), and P1 is where PI's ray meets that plane.
+/// plane { normal . p = offset } (left camera frame), and P1 is where PI's ray meets that plane; then
+/// P1 moves up or down that plane to the height of the top's crease (`up` = the shelf's normal, camera
+/// frame; SelectionParams::top_crease).
 BookFrontResult p1_on_plane(const cv::Mat& mask, int label, const Eigen::Vector3d& normal, double offset,
-                            const cv::Mat& points_camera, const StereoGeometry& g,
+                            const Eigen::Vector3d& up, const cv::Mat& points_camera, const StereoGeometry& g,
                             const Eigen::Isometry3d& camera_in_base, const SelectionParams& p, BookFrontResult out) {
   if (p.top_growth.max_px > 0)
     out.pi = raise_to_plane_top(mask, label, out.pi, points_camera, normal, offset, g, p.top_growth);
@@ -401,6 +404,23 @@ BookFrontResult p1_on_plane(const cv::Mat& mask, int label, const Eigen::Vector3
       return out;
     }
     out.p1_camera = Eigen::Vector3d(q[0], q[1], q[2]);
+  }
+  if (p.top_crease.enabled) {
+    // The window's columns: those holding the front's pixels below PI (a thin front's neighbour has its own
+    // top; the growth can leave PI well above the region).
+    const TopCreaseParams& t = p.top_crease;
+    thread_local cv::Mat columns;
+    columns.create(1, mask.cols, CV_8U);
+    columns.setTo(cv::Scalar(0));
+    for (int x = std::max(0, out.pi.x - t.right_margin_px - t.columns + 1); x <= out.pi.x && x < mask.cols; ++x)
+      for (int y = std::max(0, out.pi.y); y < mask.rows; ++y)
+        if (mask.at<int>(y, x) == label) columns.at<uchar>(0, x) = 1;
+    const TopCrease c = fit_top_crease(points_camera, g, normal, offset, up, out.pi, up.dot(out.p1_camera), columns, t);
+    const Eigen::Vector3d v = up - up.dot(normal) * normal;  // up within the front's plane
+    if (c.found && std::fabs(up.dot(v)) > 1e-6) {
+      out.top_crease_shift_m = c.height - up.dot(out.p1_camera);
+      out.p1_camera += out.top_crease_shift_m / up.dot(v) * v;
+    }
   }
   out.p1_base = camera_in_base * out.p1_camera;
   out.found = true;
@@ -624,6 +644,7 @@ BookFrontResult select_book_front(const SegmentationResult& seg, const cv::Mat& 
   // The fronts' layer lies on the plane parallel to the rear board (the cart's normal, not the region's:
   // a small region's normal can be 15 deg off, which tilts a plane across the shelf).
   const Eigen::Vector3d rear_cam = R.transpose() * rear_n;
+  const Eigen::Vector3d up_cam = R.transpose() * shelf_n;
   if (best == 0) {
     out.failure_reason = seg.regions.empty() ? "no planar region" : "no region passed the book-front tests";
     if (p.layer_disparity_px <= 0.0 || p.layer_without_front_m <= 0.0) return out;
@@ -639,7 +660,8 @@ BookFrontResult select_book_front(const SegmentationResult& seg, const cv::Mat& 
     out.failure_reason.clear();
     out.pi = layer.top;
     out.pi_from_layer = true;
-    return p1_on_plane(layer.mask, label, rear_cam, layer.offset, points_camera, g, camera_in_base, p, std::move(out));
+    return p1_on_plane(layer.mask, label, rear_cam, layer.offset, up_cam, points_camera, g, camera_in_base, p,
+                       std::move(out));
   }
   const PlaneRegion& r = seg.regions[size_t(best - 1)];
   out.selected_label = best;
@@ -715,7 +737,7 @@ BookFrontResult select_book_front(const SegmentationResult& seg, const cv::Mat& 
       offset = layer.offset;
     }
   }
-  return p1_on_plane(grow_mask, best, normal, offset, points_camera, g, camera_in_base, p, std::move(out));
+  return p1_on_plane(grow_mask, best, normal, offset, up_cam, points_camera, g, camera_in_base, p, std::move(out));
 }
 
 }  // namespace bookgrasp::bws

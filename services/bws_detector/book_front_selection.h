@@ -16,6 +16,7 @@
 /// the front's points (SelectionParams::front_plane); if the ray is nearly
 /// parallel to the plane, the region's 3D point at PI is used.
 
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -24,6 +25,7 @@
 
 #include "services/bws_detector/disparity.h"
 #include "services/bws_detector/plane_region.h"
+#include "services/bws_detector/top_crease.h"
 
 namespace bookgrasp {
 class Config;
@@ -144,6 +146,8 @@ struct SelectionParams {
   double edge_fattening_px = 0.0;
   /// The plane the top's growth climbs and P1's ray meets, for a front selected from a region.
   FrontPlane front_plane = FrontPlane::kRegion;
+  /// Then P1's height from the crease between the front and the book's top face (fit_top_crease).
+  TopCreaseParams top_crease;
 
   /// Reads every key of the `selection` section.
   static SelectionParams from_config(const Config& section);
@@ -198,6 +202,9 @@ struct BookFrontResult {
   std::vector<RegionVerdict> regions;
   /// True if PI moved right onto the front layer (SelectionParams::layer_disparity_px).
   bool pi_from_layer = false;
+  /// How far the top's crease moved P1 up its front (metres, negative = down); NaN when the crease was
+  /// not fitted or not found (SelectionParams::top_crease).
+  double top_crease_shift_m = std::numeric_limits<double>::quiet_NaN();
   /// True if the selected book front is a column band of a wider region (see split_wide_fronts);
   /// columns [band_x0, band_x1] of the selected region.
   bool split = false;

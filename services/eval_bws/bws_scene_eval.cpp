@@ -114,6 +114,7 @@ SceneResult evaluate_scene(const RenderedScene& scene, uint64_t seed, MarkerDete
     return r;
   }
   r.found = true;
+  r.top_crease_shift_m = o.selection.top_crease_shift_m;
   // Which book the corner was found on: the owner of most of the selected region's pixels within
   // kCornerWindow px of PI (and in the selected column band when the region was split).
   constexpr int kCornerWindow = 6;
@@ -255,6 +256,8 @@ Summary summarize(const std::vector<SceneResult>& rs) {
 std::string metrics_json(const std::vector<SceneResult>& rs, const std::string& impl, const std::string& scene_file,
                          uint64_t first_seed) {
   const Summary s = summarize(rs);
+  int creased = 0;  // scenes whose P1 height came from the top's crease
+  for (const SceneResult& r : rs) creased += r.found && std::isfinite(r.top_crease_shift_m);
   std::ostringstream j;
   j << "{\n  \"implementation\": \"" << impl << "\",\n  \"scene_file\": \"" << scene_file << "\",\n"
     << "  \"first_seed\": " << first_seed << ",\n  \"scenes\": " << s.scenes << ",\n  \"found\": " << s.found
@@ -262,7 +265,8 @@ std::string metrics_json(const std::vector<SceneResult>& rs, const std::string& 
     << ",\n  \"wrong_book\": " << s.wrong << ",\n  \"correct\": " << s.correct
     << ",\n  \"within_tolerance\": " << s.within_tolerance
     << ",\n  \"within_tolerance_mm\": {\"x\": " << num(kToleranceXmm, 1) << ", \"y\": " << num(kToleranceYmm, 1)
-    << "},\n  \"far_off\": " << s.far_off << ",\n  \"far_off_above_mm\": " << num(kFarOffMm, 1) << ",\n"
+    << "},\n  \"top_crease_applied\": " << creased << ",\n  \"far_off\": " << s.far_off
+    << ",\n  \"far_off_above_mm\": " << num(kFarOffMm, 1) << ",\n"
     << "  \"p1_error_mm\": {\"frame\": \"grasp (X up, Y right, Z into the shelf), |estimate - truth| over correct "
        "scenes\",\n"
     << "    \"x\": " << stats_json(s.err[0]) << ",\n    \"y\": " << stats_json(s.err[1])
@@ -281,8 +285,9 @@ std::string metrics_json(const std::vector<SceneResult>& rs, const std::string& 
       << num(r.error_grasp(0) * 1000, 2) << ", " << num(r.error_grasp(1) * 1000, 2) << ", "
       << num(r.error_grasp(2) * 1000, 2)
       << "], \"cart_marker_angle_deg\": " << (r.cart_marker_found ? num(r.cart_marker_angle_deg, 2) : "null")
-      << ", \"rightmost_width_mm\": " << num(r.rightmost_width_m * 1000, 1) << ", \"total_ms\": " << num(r.total_ms, 2)
-      << ", \"failure\": \"";
+      << ", \"rightmost_width_mm\": " << num(r.rightmost_width_m * 1000, 1)
+      << ", \"top_crease_shift_mm\": " << num(r.top_crease_shift_m * 1000, 2)
+      << ", \"total_ms\": " << num(r.total_ms, 2) << ", \"failure\": \"";
     for (char c : r.failure) j << (c == '"' || c == '\\' ? '\'' : c);
     j << "\"}" << (i + 1 < rs.size() ? "," : "") << "\n";
   }

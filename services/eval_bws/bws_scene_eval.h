@@ -8,6 +8,7 @@
 /// paper's Figure 12).
 
 #include <cstdint>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -47,6 +48,8 @@ struct SceneResult {
   int rightmost_id = -1;
   /// Right-most book's thickness, metres (truth), for the report.
   double rightmost_width_m = 0.0;
+  /// How far the top's crease moved P1 up its front, metres (NaN: not fitted or not found).
+  double top_crease_shift_m = std::numeric_limits<double>::quiet_NaN();
   /// The marker detector found the cart marker.
   bool cart_marker_found = false;
   /// Rotation between the detected cart marker pose (in base) and the true one, degrees (valid when found).

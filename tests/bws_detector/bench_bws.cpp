@@ -29,6 +29,7 @@ struct Input {
   PclPlaneParams pp, pp_metric;
   SelectionParams sp;
   SelectionParams sp_stop34;  // the selection shipped until stop 35: no front layer, holes count as gaps (baseline)
+  SelectionParams sp_no_crease;  // the shipped selection without the top's crease (stop 46's; baseline)
   Input() {
     left = test::render_boxes(scene.boxes, scene.left, true).intensity;
     right = test::render_boxes(scene.boxes, scene.right, true).intensity;
@@ -54,6 +55,8 @@ struct Input {
     sp_stop34 = sp;
     sp_stop34.layer_disparity_px = 0.0;
     sp_stop34.top_growth.max_hole_px = -1;
+    sp_no_crease = sp;
+    sp_no_crease.top_crease.enabled = false;
   }
 };
 Input& input() {
@@ -116,6 +119,10 @@ static void BM_BookFrontSelection(benchmark::State& s) {
 static void BM_BookFrontSelection_Stop34Params(benchmark::State& s) {
   selection(s, input().sp_stop34);
 }
+/// The shipped selection without the top's crease (`selection.top_crease: false`), against BM_BookFrontSelection.
+static void BM_BookFrontSelection_NoCrease(benchmark::State& s) {
+  selection(s, input().sp_no_crease);
+}
 /// The shipped selection on the same frame when no region passes (an empty segmentation): the
 /// layer placed where the volume's points are densest (`layer_without_front_m`), against
 /// BM_BookFrontSelection.
@@ -129,6 +136,7 @@ static void BM_BookFrontSelection_NoRegionPasses(benchmark::State& s) {
 }
 BENCHMARK(BM_BookFrontSelection)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_BookFrontSelection_Stop34Params)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_BookFrontSelection_NoCrease)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_BookFrontSelection_NoRegionPasses)->Unit(benchmark::kMillisecond);
 
 static void BM_PclSegmentation(benchmark::State& s) {

@@ -29,7 +29,13 @@ TEST(BwsSceneEval, CountsFailuresTolerancesAndFarOffCorners) {
       scene(4, true, true, -100.0, -40.0, 3.0),  // wrong book: not in the error statistics
       scene(5, false, false, 0.0, 0.0, 0.0),     // no P1
   };
-  const YAML::Node j = YAML::Load(metrics_json(rs, "god", "config/scenes/default.yaml", 1));
+  std::vector<SceneResult> with_crease = rs;
+  with_crease[0].top_crease_shift_m = -0.004;  // P1's height from the top's crease: 4 mm down
+  with_crease[4].top_crease_shift_m = 0.002;   // no P1: not counted
+  const YAML::Node j = YAML::Load(metrics_json(with_crease, "god", "config/scenes/default.yaml", 1));
+  EXPECT_EQ(j["top_crease_applied"].as<int>(), 1);
+  EXPECT_NEAR(j["per_scene"][0]["top_crease_shift_mm"].as<double>(), -4.0, 1e-9);
+  EXPECT_TRUE(j["per_scene"][1]["top_crease_shift_mm"].IsNull());
   EXPECT_EQ(j["scenes"].as<int>(), 5);
   EXPECT_EQ(j["found"].as<int>(), 4);
   EXPECT_EQ(j["no_p1"].as<int>(), 1);
