@@ -61,8 +61,11 @@ TopCrease fit_top_crease(const cv::Mat& points_camera, const StereoGeometry& g, 
   };
   const double h_lo = start_height - p.search_down_m, h_hi = start_height + p.search_up_m;
   const double r_top = row_at_height(h_hi), r_bottom = row_at_height(h_lo);
-  const int y0 = std::max(0, int(std::floor(std::min(r_top, r_bottom))) - p.rows_above);
-  const int y1 = std::min(points_camera.rows - 1, int(std::ceil(std::max(r_top, r_bottom))) + p.rows_below);
+  // Clamped before the conversion: a ray almost parallel to the front's plane projects far out.
+  const double rows = points_camera.rows;
+  const int y0 = std::max(0, int(std::floor(std::clamp(std::min(r_top, r_bottom), -1.0, rows))) - p.rows_above);
+  const int y1 = std::min(points_camera.rows - 1,
+                          int(std::ceil(std::clamp(std::max(r_top, r_bottom), -1.0, rows))) + p.rows_below);
   const int x1 = std::min(points_camera.cols - 1, pi.x - p.right_margin_px);
   const int x0 = std::max(0, x1 - p.columns + 1);
   // The window's columns of the front; the check fits its right-most p.right_columns apart from the rest.

@@ -21,12 +21,13 @@ class Config;
 
 namespace bookgrasp::bws {
 
-/// Window, search range and acceptance of fit_top_crease (config keys `selection.top_crease_*`).
+/// Window, search range and acceptance of fit_top_crease (config keys `selection.top_crease_*`; the defaults
+/// are the shipped values).
 struct TopCreaseParams {
   /// Off: P1 keeps the height of PI's ray.
   bool enabled = false;
   /// Columns of the window: this many ending `right_margin_px` left of PI's column ...
-  int columns = 6;
+  int columns = 10;
   /// ... (the front's right border, fattened by block matching, stays out).
   int right_margin_px = 2;
   /// Rows of the window: from this many above the row of the highest height searched ...
@@ -50,7 +51,7 @@ struct TopCreaseParams {
   int right_columns = 3;
   /// ... (metres; 0 = not checked; a single column is not checked): a thin front's window reaches into a
   /// taller neighbour, whose top the right-most columns do not share.
-  double max_right_difference_m = 0.0;
+  double max_right_difference_m = 0.01;
 
   /// Reads the `top_crease_*` keys of the `selection` section.
   static TopCreaseParams from_config(const Config& selection);

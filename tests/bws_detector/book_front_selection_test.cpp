@@ -314,8 +314,6 @@ TEST(SelectBookFront, TheTopsCreaseSetsP1sHeight) {
     sp.front_plane = FrontPlane::kRearBoard;
     const BookFrontResult off = detect(scene, disp, ren, nullptr, sp);
     sp.top_crease.enabled = true;
-    sp.top_crease.columns = 10;
-    sp.top_crease.max_right_difference_m = 0.01;
     const BookFrontResult on = detect(scene, disp, ren, nullptr, sp);
     ASSERT_TRUE(off.found && on.found) << "seed " << seed;
     ASSERT_TRUE(std::isfinite(on.top_crease_shift_m)) << "seed " << seed << ": no crease fitted";

@@ -3,6 +3,7 @@
 #include "services/bws_detector/top_crease.h"
 
 #include <cmath>
+#include <string>
 
 #include <gtest/gtest.h>
 #include <opencv2/imgproc.hpp>
@@ -27,6 +28,7 @@ struct BookFromAbove {
   Eigen::Vector3d normal, up;  // the front's normal (towards the far side) and base z, camera frame
   double offset = 0.0;         // normal . p of the front
   double true_height = 0.0;    // up . p of the top edge
+  cv::Mat face_id;             // the render's surface ids (box index * 6 + face + 1; the book is box 0)
 
   /// A book 4 cm wide; `thin_with_taller_neighbour`: 5 mm wide (5 px), with a book 4 cm taller on its left.
   explicit BookFromAbove(bool thin_with_taller_neighbour = false) {
@@ -53,6 +55,7 @@ struct BookFromAbove {
       boxes.push_back(n);
     }
     const test::RenderOutput r = test::render_boxes(boxes, cam, false);
+    face_id = r.face_id;
     g = {cam.fx, cam.fy, cam.cx, cam.cy, kBaseline};
     points.create(r.depth.size(), CV_32FC3);
     for (int y = 0; y < points.rows; ++y)
@@ -91,7 +94,7 @@ struct BookFromAbove {
   }
 };
 
-TopCreaseParams shipped_like() {
+TopCreaseParams as_shipped() {
   TopCreaseParams p;
   p.enabled = true;
   return p;
@@ -102,7 +105,7 @@ TEST(TopCrease, FindsTheTopEdgesHeightFromBelowAndFromAbove) {
   const cv::Point pi = b.corner_px();
   // P1 started 2.5 cm too low (a missed top) and 1.2 cm too high (the growth onto the top face).
   for (const double start_error : {-0.025, 0.012}) {
-    const TopCrease c = b.fit(pi, b.true_height + start_error, shipped_like());
+    const TopCrease c = b.fit(pi, b.true_height + start_error, as_shipped());
     ASSERT_TRUE(c.found) << start_error;
     EXPECT_NEAR(c.height, b.true_height, 0.001) << start_error;
     EXPECT_GE(c.front_pixels, 12);
@@ -113,7 +116,7 @@ TEST(TopCrease, FindsTheTopEdgesHeightFromBelowAndFromAbove) {
 TEST(TopCrease, ABlurredCreaseKeepsItsHeight) {
   BookFromAbove b;
   b.blur_disparity(7);  // StereoBM's block size as shipped
-  const TopCrease c = b.fit(b.corner_px(), b.true_height + 0.01, shipped_like());
+  const TopCrease c = b.fit(b.corner_px(), b.true_height + 0.01, as_shipped());
   ASSERT_TRUE(c.found);
   EXPECT_NEAR(c.height, b.true_height, 0.0015);
 }
@@ -121,7 +124,7 @@ TEST(TopCrease, ABlurredCreaseKeepsItsHeight) {
 TEST(TopCrease, AThinFrontsWindowInATallerNeighbourFailsTheRightColumnsCheck) {
   const BookFromAbove b(true);
   const cv::Point pi = b.corner_px();
-  TopCreaseParams p = shipped_like();
+  TopCreaseParams p = as_shipped();
   p.max_right_difference_m = 0.0;
   const TopCrease unchecked = b.fit(pi, b.true_height, p);
   // Without the check the window's left columns, on the neighbour 4 cm taller, pull the height up.
@@ -139,24 +142,47 @@ TEST(TopCrease, AThinFrontsWindowInATallerNeighbourFailsTheRightColumnsCheck) {
 
 TEST(TopCrease, NoTopFaceInTheDepthNoCrease) {
   BookFromAbove b;
-  // The top face unmatched (a dark, textureless cover): no depth above the edge in the book's columns.
+  // The book's top face (box 0, face +z) unmatched, as a dark, textureless cover is: no depth on it.
   const cv::Point pi = b.corner_px();
-  for (int y = 0; y < pi.y; ++y)
-    for (int x = pi.x - 20; x <= pi.x; ++x) b.points.at<cv::Vec3f>(y, x) = cv::Vec3f(NAN, NAN, NAN);
-  const TopCrease c = b.fit(pi, b.true_height, shipped_like());
+  constexpr int kTopFace = 0 * 6 + 5 + 1;
+  for (int y = 0; y < b.points.rows; ++y)
+    for (int x = 0; x < b.points.cols; ++x)
+      if (b.face_id.at<int>(y, x) == kTopFace) b.points.at<cv::Vec3f>(y, x) = cv::Vec3f(NAN, NAN, NAN);
+  const TopCrease c = b.fit(pi, b.true_height, as_shipped());
   EXPECT_FALSE(c.found);
-  EXPECT_LT(c.top_pixels, shipped_like().min_pixels_each_side);
+  EXPECT_LT(c.top_pixels, as_shipped().min_pixels_each_side);
 }
 
 TEST(TopCrease, OnlyTheFrontsColumnsCount) {
   const BookFromAbove b;
   const cv::Point pi = b.corner_px();
   cv::Mat none(1, b.points.cols, CV_8U, cv::Scalar(0));
-  EXPECT_FALSE(b.fit(pi, b.true_height, shipped_like(), none).found);
+  EXPECT_FALSE(b.fit(pi, b.true_height, as_shipped(), none).found);
   cv::Mat all(1, b.points.cols, CV_8U, cv::Scalar(1));
-  EXPECT_TRUE(b.fit(pi, b.true_height, shipped_like(), all).found);
-  EXPECT_THROW(fit_top_crease(cv::Mat(3, 3, CV_32F), b.g, b.normal, b.offset, b.up, pi, 0.0, cv::Mat(), shipped_like()),
+  EXPECT_TRUE(b.fit(pi, b.true_height, as_shipped(), all).found);
+  EXPECT_THROW(fit_top_crease(cv::Mat(3, 3, CV_32F), b.g, b.normal, b.offset, b.up, pi, 0.0, cv::Mat(), as_shipped()),
                std::invalid_argument);
+}
+
+// The tests above fit with the struct's defaults (as_shipped): they must be what both implementations ship.
+TEST(TopCreaseParams, TheDefaultsAreTheShippedValues) {
+  const TopCreaseParams d;
+  for (const char* file : {"bws_detector.yaml", "bws_detector_pcl.yaml"}) {
+    const TopCreaseParams p = TopCreaseParams::from_config(
+        Config::load_file(std::string(BOOKGRASP_SOURCE_DIR) + "/config/services/" + file).child("selection"));
+    EXPECT_TRUE(p.enabled) << file;
+    EXPECT_EQ(p.columns, d.columns) << file;
+    EXPECT_EQ(p.right_margin_px, d.right_margin_px) << file;
+    EXPECT_EQ(p.rows_above, d.rows_above) << file;
+    EXPECT_EQ(p.rows_below, d.rows_below) << file;
+    EXPECT_DOUBLE_EQ(p.search_down_m, d.search_down_m) << file;
+    EXPECT_DOUBLE_EQ(p.search_up_m, d.search_up_m) << file;
+    EXPECT_DOUBLE_EQ(p.step_m, d.step_m) << file;
+    EXPECT_DOUBLE_EQ(p.residual_cap_px, d.residual_cap_px) << file;
+    EXPECT_EQ(p.min_pixels_each_side, d.min_pixels_each_side) << file;
+    EXPECT_EQ(p.right_columns, d.right_columns) << file;
+    EXPECT_DOUBLE_EQ(p.max_right_difference_m, d.max_right_difference_m) << file;
+  }
 }
 
 TEST(TopCreaseParams, ReadsEveryKeyAndRefusesBadOnes) {
