@@ -342,7 +342,8 @@ cv::Mat figure12_plot(const std::vector<SceneResult>& rs, const std::string& tit
   ymax = std::ceil(std::min(ymax, 60.0) / 5.0) * 5.0;
   const int pw = W - L - R, ph = H - T - B;
   const auto ypix = [&](double v) { return T + ph - int(std::round(std::min(v, ymax) / ymax * ph)); };
-  for (double v = 0; v <= ymax + 1e-9; v += ymax / 5) {
+  for (int k = 0; k <= 5; ++k) {
+    const double v = ymax * k / 5;
     cv::line(img, {L, ypix(v)}, {W - R, ypix(v)}, cv::Scalar(225, 225, 225));
     cv::putText(img, num(v, 0), {L - 40, ypix(v) + 5}, cv::FONT_HERSHEY_SIMPLEX, 0.45, cv::Scalar(0, 0, 0), 1,
                 cv::LINE_AA);
