@@ -413,10 +413,10 @@ BookFrontResult p1_on_plane(const cv::Mat& mask, int label, const Eigen::Vector3
     columns.create(1, mask.cols, CV_8U);
     columns.setTo(cv::Scalar(0));
     for (int x = std::max(0, out.pi.x - t.right_margin_px - t.columns + 1); x <= out.pi.x && x < mask.cols; ++x)
-      for (int y = std::max(0, out.pi.y); y < mask.rows; ++y)
+      for (int y = std::max(0, out.pi.y); y < mask.rows && !columns.at<uchar>(0, x); ++y)
         if (mask.at<int>(y, x) == label) columns.at<uchar>(0, x) = 1;
     const TopCrease c = fit_top_crease(points_camera, g, normal, offset, up, out.pi, up.dot(out.p1_camera), columns, t);
-    const Eigen::Vector3d v = up - up.dot(normal) * normal;  // up within the front's plane
+    const Eigen::Vector3d v = up_within_plane(up, normal);
     if (c.found && std::fabs(up.dot(v)) > 1e-6) {
       out.top_crease_shift_m = c.height - up.dot(out.p1_camera);
       out.p1_camera += out.top_crease_shift_m / up.dot(v) * v;

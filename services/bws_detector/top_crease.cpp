@@ -39,6 +39,10 @@ struct WindowPixel {
 };
 }  // namespace
 
+Eigen::Vector3d up_within_plane(const Eigen::Vector3d& up, const Eigen::Vector3d& normal) {
+  return up - up.dot(normal) * normal;
+}
+
 TopCrease fit_top_crease(const cv::Mat& points_camera, const StereoGeometry& g, const Eigen::Vector3d& normal,
                          double offset, const Eigen::Vector3d& up, cv::Point pi, double start_height,
                          const cv::Mat& columns_mask, const TopCreaseParams& p) {
@@ -46,16 +50,16 @@ TopCrease fit_top_crease(const cv::Mat& points_camera, const StereoGeometry& g, 
   TopCrease out;
   const double fb = g.fx * g.baseline_m;
   const auto ray_of = [&](double x, double y) { return Eigen::Vector3d((x - g.cx) / g.fx, (y - g.cy) / g.fy, 1.0); };
-  // The rows the searched heights project to in PI's column (the front's top edge moves along it).
+  // The rows the searched heights project to in PI's column (the front's top edge moves along it): the point
+  // on the front's plane at height h straight above or below PI's point q, projected.
+  const Eigen::Vector3d pi_ray = ray_of(pi.x, pi.y);
+  const double pi_dn = normal.dot(pi_ray);
+  const Eigen::Vector3d q = pi_ray * (offset / pi_dn);
+  Eigen::Vector3d v = up_within_plane(up, normal);
+  const bool projects = std::fabs(pi_dn) >= 1e-9 && v.norm() >= 1e-9;
+  v /= up.dot(v);  // so that up . (q + s v) = up . q + s
   const auto row_at_height = [&](double h) {
-    // The point on the front's plane at height h straight above or below PI's point, projected.
-    const Eigen::Vector3d r = ray_of(pi.x, pi.y);
-    const double dn = normal.dot(r);
-    if (std::fabs(dn) < 1e-9) return double(pi.y);
-    const Eigen::Vector3d q = r * (offset / dn);
-    Eigen::Vector3d v = up - up.dot(normal) * normal;  // up within the front's plane
-    if (v.norm() < 1e-9) return double(pi.y);
-    v /= up.dot(v);  // so that up . (q + s v) = up . q + s
+    if (!projects) return double(pi.y);
     const Eigen::Vector3d a = q + (h - up.dot(q)) * v;
     return a.z() > 1e-6 ? g.fy * a.y() / a.z() + g.cy : double(pi.y);
   };

@@ -74,6 +74,10 @@ struct TopCrease {
   double right_height = 0.0;
 };
 
+/// The direction up the front's plane { normal . p = offset }: `up` without its part along the (unit)
+/// `normal`, not normalised (up . v = 1 - (up . normal)^2; zero when the front lies flat).
+Eigen::Vector3d up_within_plane(const Eigen::Vector3d& up, const Eigen::Vector3d& normal);
+
 /// Fits the front's top edge near PI. The front is the plane { normal . p = offset } and the top face
 /// the plane { up . p = h } (left camera frame; `up` is the shelf's normal, pointing up, unit). The
 /// window is TopCreaseParams' columns left of `pi` and the rows around the heights searched, which

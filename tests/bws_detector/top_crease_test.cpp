@@ -24,7 +24,7 @@ constexpr double kBaseline = 0.12;
 struct BookFromAbove {
   test::PinholeCamera cam;
   StereoGeometry g;
-  cv::Mat points;
+  cv::Mat disparity, points;   // exact disparity (NaN = nothing hit) and its points
   Eigen::Vector3d normal, up;  // the front's normal (towards the far side) and base z, camera frame
   double offset = 0.0;         // normal . p of the front
   double true_height = 0.0;    // up . p of the top edge
@@ -57,12 +57,8 @@ struct BookFromAbove {
     const test::RenderOutput r = test::render_boxes(boxes, cam, false);
     face_id = r.face_id;
     g = {cam.fx, cam.fy, cam.cx, cam.cy, kBaseline};
-    points.create(r.depth.size(), CV_32FC3);
-    for (int y = 0; y < points.rows; ++y)
-      for (int x = 0; x < points.cols; ++x) {
-        const float z = r.depth.at<float>(y, x);
-        points.at<cv::Vec3f>(y, x) = cv::Vec3f(float((x - cam.cx) / cam.fx * z), float((y - cam.cy) / cam.fy * z), z);
-      }
+    disparity = test::exact_disparity(r.depth, cam.fx, kBaseline);
+    points = disparity_to_points(disparity, g);
     normal = R.transpose() * Eigen::Vector3d::UnitX();
     offset = kFrontX;  // the camera sits at the base origin
     up = R.transpose() * Eigen::Vector3d::UnitZ();
@@ -76,18 +72,10 @@ struct BookFromAbove {
   /// Replaces the points' depth by that of a box-filtered disparity (ksize x ksize), like block matching's
   /// blur of the crease and of the book's borders.
   void blur_disparity(int ksize) {
-    cv::Mat d(points.size(), CV_32F);
-    for (int y = 0; y < d.rows; ++y)
-      for (int x = 0; x < d.cols; ++x) {
-        const float z = points.at<cv::Vec3f>(y, x)[2];
-        d.at<float>(y, x) = std::isfinite(z) ? float(g.fx * kBaseline / z) : 0.0f;
-      }
+    cv::Mat d = disparity.clone();
+    d.setTo(0.0f, d != d);  // NaN (nothing hit) counts as 0 in the box, as before the points are taken
     cv::blur(d, d, {ksize, ksize});
-    for (int y = 0; y < d.rows; ++y)
-      for (int x = 0; x < d.cols; ++x) {
-        const float z = float(g.fx * kBaseline / d.at<float>(y, x));
-        points.at<cv::Vec3f>(y, x) = cv::Vec3f(float((x - cam.cx) / cam.fx * z), float((y - cam.cy) / cam.fy * z), z);
-      }
+    points = disparity_to_points(d, g);
   }
   TopCrease fit(cv::Point pi, double start, const TopCreaseParams& p, const cv::Mat& columns = cv::Mat()) const {
     return fit_top_crease(points, g, normal, offset, up, pi, start, columns, p);
